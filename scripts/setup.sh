@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Installs the Debian packages iesrgs needs (only the missing ones), then configures and builds.
+#   scripts/setup.sh            release build in build/
+#   scripts/setup.sh --asan     AddressSanitizer + UBSan build in build-asan/
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(
+  build-essential cmake pkg-config
+  libtorch-dev          # tensors, autograd, Adam, .pth checkpoints
+  libcli11-dev nlohmann-json3-dev libstb-dev libfmt-dev libspdlog-dev zlib1g-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for package in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" ||
+    missing+=("$package")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+build_dir=build
+options=(-DCMAKE_BUILD_TYPE=Release)
+if [ "${1:-}" = "--asan" ]; then
+  build_dir=build-asan
+  options=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DIESRGS_SANITIZE=ON -DIESRGS_BENCH=OFF)
+fi
+cmake -S . -B "$build_dir" "${options[@]}" >/dev/null
+cmake --build "$build_dir" -j "$(nproc)"
+echo "setup: built $build_dir/iesrgs"
