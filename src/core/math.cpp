@@ -1,0 +1,38 @@
+#include "core/math.hpp"
+
+namespace iesrgs {
+
+std::array<double, 4> rotation_to_quat(const Mat3& r) {
+  const double trace = r(0, 0) + r(1, 1) + r(2, 2);
+  double w, x, y, z;
+  if (trace > 0) {
+    const double s = 2 * std::sqrt(trace + 1);
+    w = s / 4;
+    x = (r(2, 1) - r(1, 2)) / s;
+    y = (r(0, 2) - r(2, 0)) / s;
+    z = (r(1, 0) - r(0, 1)) / s;
+  } else if (r(0, 0) > r(1, 1) && r(0, 0) > r(2, 2)) {
+    const double s = 2 * std::sqrt(1 + r(0, 0) - r(1, 1) - r(2, 2));
+    w = (r(2, 1) - r(1, 2)) / s;
+    x = s / 4;
+    y = (r(0, 1) + r(1, 0)) / s;
+    z = (r(0, 2) + r(2, 0)) / s;
+  } else if (r(1, 1) > r(2, 2)) {
+    const double s = 2 * std::sqrt(1 + r(1, 1) - r(0, 0) - r(2, 2));
+    w = (r(0, 2) - r(2, 0)) / s;
+    x = (r(0, 1) + r(1, 0)) / s;
+    y = s / 4;
+    z = (r(1, 2) + r(2, 1)) / s;
+  } else {
+    const double s = 2 * std::sqrt(1 + r(2, 2) - r(0, 0) - r(1, 1));
+    w = (r(1, 0) - r(0, 1)) / s;
+    x = (r(0, 2) + r(2, 0)) / s;
+    y = (r(1, 2) + r(2, 1)) / s;
+    z = s / 4;
+  }
+  // A canonical sign keeps written files reproducible.
+  if (w < 0) return {-w, -x, -y, -z};
+  return {w, x, y, z};
+}
+
+}  // namespace iesrgs

@@ -1,0 +1,61 @@
+#pragma once
+// Small fixed-size vector and matrix types for camera geometry (double precision on the host).
+#include <array>
+#include <cmath>
+
+namespace iesrgs {
+
+struct Vec3 {
+  double x = 0, y = 0, z = 0;
+
+  double operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+  Vec3 operator+(const Vec3& o) const { return {x + o.x, y + o.y, z + o.z}; }
+  Vec3 operator-(const Vec3& o) const { return {x - o.x, y - o.y, z - o.z}; }
+  Vec3 operator*(double s) const { return {x * s, y * s, z * s}; }
+  Vec3 operator-() const { return {-x, -y, -z}; }
+  double dot(const Vec3& o) const { return x * o.x + y * o.y + z * o.z; }
+  Vec3 cross(const Vec3& o) const {
+    return {y * o.z - z * o.y, z * o.x - x * o.z, x * o.y - y * o.x};
+  }
+  double norm() const { return std::sqrt(dot(*this)); }
+};
+
+// Row-major 3x3 matrix.
+struct Mat3 {
+  std::array<double, 9> m{1, 0, 0, 0, 1, 0, 0, 0, 1};
+
+  double operator()(int r, int c) const { return m[r * 3 + c]; }
+  double& operator()(int r, int c) { return m[r * 3 + c]; }
+
+  Vec3 operator*(const Vec3& v) const {
+    return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[3] * v.x + m[4] * v.y + m[5] * v.z,
+            m[6] * v.x + m[7] * v.y + m[8] * v.z};
+  }
+  Mat3 operator*(const Mat3& o) const {
+    Mat3 r;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        r(i, j) = (*this)(i, 0) * o(0, j) + (*this)(i, 1) * o(1, j) + (*this)(i, 2) * o(2, j);
+    return r;
+  }
+  Mat3 transposed() const {
+    Mat3 r;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) r(i, j) = (*this)(j, i);
+    return r;
+  }
+};
+
+// Rotation matrix from a unit quaternion (w, x, y, z), as COLMAP stores it.
+inline Mat3 quat_to_rotation(double w, double x, double y, double z) {
+  Mat3 r;
+  r.m = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+         2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+         2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+  return r;
+}
+
+// Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method, numerically stable).
+std::array<double, 4> rotation_to_quat(const Mat3& r);
+
+}  // namespace iesrgs

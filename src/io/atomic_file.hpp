@@ -1,0 +1,21 @@
+#pragma once
+// Every output is written to "<name>.tmp-<pid>" first and renamed into place when complete, so
+// an interrupted run never leaves a half-written file under the final name.
+#include <filesystem>
+#include <functional>
+#include <string>
+
+namespace iesrgs {
+
+// Calls write(tmp_path), then renames tmp_path to path. On any failure the temporary is removed
+// and an Error naming `path` is thrown. Creates missing parent directories.
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(const std::filesystem::path&)>& write);
+
+// Atomic text / binary file writes.
+void write_file_atomically(const std::filesystem::path& path, const std::string& bytes);
+
+// Whole file into memory; throws Error naming the file when it cannot be read.
+std::string read_file(const std::filesystem::path& path);
+
+}  // namespace iesrgs

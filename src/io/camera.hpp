@@ -1,0 +1,59 @@
+#pragma once
+// A posed pinhole camera in the OpenCV convention used everywhere inside iesrgs:
+// x right, y down, z forward; world-to-camera p_cam = R * p_world + t.
+#include <filesystem>
+#include <string>
+
+#include "core/math.hpp"
+
+namespace iesrgs {
+
+enum class Split { Train, Test };
+
+const char* split_name(Split split);
+
+// Lens distortion of the stored image, in the OpenCV / COLMAP model
+// (radial k1, k2; tangential p1, p2). All zero means the image is already pinhole.
+struct Distortion {
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;
+
+  bool any() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0; }
+  // Maps normalized undistorted coordinates (x, y) to distorted ones.
+  void apply(double x, double y, double& xd, double& yd) const {
+    const double r2 = x * x + y * y;
+    const double radial = 1 + k1 * r2 + k2 * r2 * r2;
+    xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+    yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
+  }
+};
+
+struct Intrinsics {
+  int width = 0, height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+
+  // The same field of view at `scale` times the resolution (pixel centers at +0.5).
+  Intrinsics scaled(double scale) const;
+  double fov_x() const;
+  double fov_y() const;
+};
+
+struct Camera {
+  std::string name;  // image file stem, used to name renders after the ground truth
+  Split split = Split::Train;
+  Intrinsics intrinsics;             // the pinhole model the renderer uses (after --downscale)
+  Mat3 rotation;                     // world-to-camera
+  Vec3 translation;                  // world-to-camera
+  std::filesystem::path image_path;  // full-resolution image as stored
+  Intrinsics stored;                 // of the image at image_path
+  Distortion distortion;  // of the stored image; loading undistorts it to a pinhole image
+
+  Vec3 center() const { return -(rotation.transposed() * translation); }
+  // Same pose, `scale` times the resolution (rendering at s x is just another camera).
+  Camera scaled(double scale) const;
+};
+
+// World-to-camera (OpenCV) from a camera-to-world matrix in the OpenGL / NeRF convention
+// (x right, y up, z backward), as stored by NeRF-Synthetic and nerfstudio transforms.json.
+void opengl_c2w_to_opencv_w2c(const double c2w[4][4], Mat3& rotation, Vec3& translation);
+
+}  // namespace iesrgs

@@ -1,0 +1,54 @@
+#pragma once
+// 8-bit and float images (interleaved HWC) with PNG / JPEG decoding and atomic PNG writing.
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace iesrgs {
+
+// Interleaved channels, row-major, values in [0, 1] for color.
+struct Image {
+  int width = 0, height = 0, channels = 0;
+  std::vector<float> data;
+
+  Image() = default;
+  Image(int w, int h, int c) : width(w), height(h), channels(c), data(size_t(w) * h * c, 0.f) {}
+  float& at(int x, int y, int c) { return data[(size_t(y) * width + x) * channels + c]; }
+  float at(int x, int y, int c) const { return data[(size_t(y) * width + x) * channels + c]; }
+  size_t pixels() const { return size_t(width) * height; }
+};
+
+// 8-bit image as stored in files.
+struct Image8 {
+  int width = 0, height = 0, channels = 0;
+  std::vector<uint8_t> data;
+
+  Image8() = default;
+  Image8(int w, int h, int c) : width(w), height(h), channels(c), data(size_t(w) * h * c, 0) {}
+  uint8_t& at(int x, int y, int c) { return data[(size_t(y) * width + x) * channels + c]; }
+  uint8_t at(int x, int y, int c) const { return data[(size_t(y) * width + x) * channels + c]; }
+};
+
+struct ImageHeader {
+  int width = 0, height = 0, channels = 0;
+};
+
+// Reads only the header; throws Error naming the file when it is missing or not an image.
+ImageHeader read_image_header(const std::filesystem::path& path);
+// Decodes a PNG or JPEG keeping its channel count (1, 2, 3 or 4).
+Image8 read_image8(const std::filesystem::path& path);
+
+Image to_float(const Image8& image);
+Image8 to_8bit(const Image& image);  // rounds and clamps to [0, 255]
+
+// RGB from RGB(A) or gray(+alpha): alpha is composited over `background` (linear, as 3DGS does).
+Image composite_rgb(const Image8& image, const float background[3]);
+
+// Writes a PNG through a temporary name and a rename, so a crash never leaves half a file.
+void write_png(const std::filesystem::path& path, const Image8& image);
+void write_png(const std::filesystem::path& path, const Image& image);
+// 16-bit single-channel PNG (e.g. depth), big-endian samples as the PNG standard wants.
+void write_png16(const std::filesystem::path& path, const std::vector<uint16_t>& gray, int width,
+                 int height);
+
+}  // namespace iesrgs

@@ -1,0 +1,62 @@
+#include "io/scene.hpp"
+
+#include <algorithm>
+
+#include "core/error.hpp"
+#include "io/colmap.hpp"
+#include "io/transforms.hpp"
+
+namespace iesrgs {
+
+namespace fs = std::filesystem;
+
+std::vector<const Camera*> Scene::split(Split which) const {
+  std::vector<const Camera*> out;
+  for (const Camera& camera : cameras)
+    if (camera.split == which) out.push_back(&camera);
+  return out;
+}
+
+SceneNormalization Scene::normalization() const {
+  std::vector<Vec3> centers;
+  for (const Camera* camera : split(Split::Train)) centers.push_back(camera->center());
+  if (centers.empty())
+    for (const Camera& camera : cameras) centers.push_back(camera.center());
+  SceneNormalization norm;
+  if (centers.empty()) return norm;
+  for (const Vec3& c : centers) norm.center = norm.center + c * (1.0 / centers.size());
+  double largest = 0;
+  for (const Vec3& c : centers) largest = std::max(largest, (c - norm.center).norm());
+  norm.radius = largest * 1.1;
+  return norm;
+}
+
+namespace {
+
+Scene read_any_format(const fs::path& root, const SceneOptions& options) {
+  std::error_code ec;
+  if (fs::is_regular_file(root, ec) && root.extension() == ".json")
+    return read_nerfstudio_scene(root, options);
+  if (!fs::is_directory(root, ec)) fail_file(root, "scene directory not found");
+  if (fs::exists(root / "transforms_train.json", ec)) return read_blender_scene(root, options);
+  if (fs::exists(root / "transforms.json", ec))
+    return read_nerfstudio_scene(root / "transforms.json", options);
+  if (fs::is_directory(root / "sparse", ec)) return read_colmap_scene(root, options);
+  fail_file(root, "no scene found (looked for transforms_train.json, transforms.json, sparse/0/)");
+}
+
+}  // namespace
+
+Scene load_scene(const fs::path& root, const SceneOptions& options) {
+  if (options.downscale < 1) fail("--downscale must be at least 1, got {}", options.downscale);
+  Scene scene = read_any_format(root, options);
+  if (scene.cameras.empty()) fail_file(root, "scene has no cameras");
+  scene.root = root;
+  scene.background = options.background;
+  scene.downscale = options.downscale;
+  for (Camera& camera : scene.cameras)
+    camera.intrinsics = camera.stored.scaled(1.0 / options.downscale);
+  return scene;
+}
+
+}  // namespace iesrgs

@@ -1,0 +1,49 @@
+#pragma once
+// One in-memory model of a posed capture, whatever format it came from.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "io/camera.hpp"
+
+namespace iesrgs {
+
+// Sparse SfM points (COLMAP points3D), empty for synthetic scenes.
+struct PointCloud {
+  std::vector<Vec3> positions;
+  std::vector<std::array<uint8_t, 3>> colors;
+};
+
+// Scene center and extent exactly as 3DGS's getNerfppNorm: center of the camera centers, radius
+// = 1.1 x the largest distance of a camera center from it. Learning rates scale with `radius`.
+struct SceneNormalization {
+  Vec3 center;
+  double radius = 1;
+};
+
+struct Scene {
+  std::filesystem::path root;
+  std::string format;  // "blender", "nerfstudio" or "colmap"
+  std::vector<Camera> cameras;
+  PointCloud points;
+  std::array<float, 3> background{1, 1, 1};  // RGBA images are composited over it
+  bool synthetic = false;  // object-centric with a known bounding volume (NeRF Synthetic)
+  int downscale = 1;       // cameras' intrinsics are the stored ones divided by this
+
+  std::vector<const Camera*> split(Split which) const;
+  SceneNormalization normalization() const;  // from the training cameras
+};
+
+struct SceneOptions {
+  int downscale = 1;                         // read <images>_<k> when present, else resize
+  std::array<float, 3> background{1, 1, 1};  // for RGBA images
+  int test_every = 8;                        // LLFF hold-out for formats without a test split
+};
+
+// Detects the format from the files present and loads cameras and points (not the images).
+// Every camera's intrinsics are already at 1/downscale of the stored resolution.
+Scene load_scene(const std::filesystem::path& root, const SceneOptions& options = {});
+
+}  // namespace iesrgs

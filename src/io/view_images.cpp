@@ -1,0 +1,141 @@
+#include "io/view_images.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdlib>
+#include <functional>
+
+#include "core/error.hpp"
+#include "io/resize.hpp"
+#include "io/undistort.hpp"
+
+namespace iesrgs {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string describe(const Intrinsics& k) {
+  return fmt::format("{}x{}", k.width, k.height);
+}
+
+// The pre-downscaled copy "<dir>_<k>/<file>" (COLMAP / nerfstudio convention), if present.
+fs::path downscaled_copy(const fs::path& image_path, int downscale) {
+  if (downscale <= 1) return {};
+  const fs::path dir = image_path.parent_path();
+  const fs::path candidate = dir.parent_path() /
+                             (dir.filename().string() + "_" + std::to_string(downscale)) /
+                             image_path.filename();
+  std::error_code ec;
+  return fs::is_regular_file(candidate, ec) ? candidate : fs::path{};
+}
+
+// Identifies an undistorted result: the source file's identity and every parameter used.
+std::string undistort_key(const fs::path& source, const Intrinsics& k, const Distortion& d) {
+  std::error_code ec;
+  const auto size = fs::file_size(source, ec);
+  const auto mtime = fs::last_write_time(source, ec).time_since_epoch().count();
+  const std::string identity =
+      fmt::format("{}|{}|{}|{}x{}|{:.9g},{:.9g},{:.9g},{:.9g}|{:.9g},{:.9g},{:.9g},{:.9g}",
+                  fs::absolute(source).string(), size, mtime, k.width, k.height, k.fx, k.fy, k.cx,
+                  k.cy, d.k1, d.k2, d.p1, d.p2);
+  return fmt::format("{:016x}", std::hash<std::string>{}(identity));
+}
+
+}  // namespace
+
+fs::path ViewImageOptions::default_cache_dir() {
+  if (const char* dir = std::getenv("IESRGS_CACHE_DIR"); dir && *dir) return dir;
+  if (const char* dir = std::getenv("XDG_CACHE_HOME"); dir && *dir) return fs::path(dir) / "iesrgs";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return fs::path(home) / ".cache" / "iesrgs";
+  return fs::temp_directory_path() / "iesrgs-cache";
+}
+
+ViewImages::ViewImages(const Scene& scene, ViewImageOptions options)
+    : scene_(scene), options_(std::move(options)) {}
+
+Image8 ViewImages::read_source(const Camera& camera, Intrinsics& source_intrinsics) const {
+  if (const fs::path copy = downscaled_copy(camera.image_path, scene_.downscale); !copy.empty()) {
+    Image8 image = read_image8(copy);
+    const Intrinsics expected = camera.stored.scaled(1.0 / scene_.downscale);
+    if (std::abs(image.width - expected.width) > 1 || std::abs(image.height - expected.height) > 1)
+      fail_file(copy, fmt::format("image is {}x{}, expected about {} (1/{} of {})", image.width,
+                                  image.height, describe(expected), scene_.downscale,
+                                  describe(camera.stored)));
+    source_intrinsics =
+        camera.stored.scaled(static_cast<double>(image.width) / camera.stored.width);
+    source_intrinsics.width = image.width;
+    source_intrinsics.height = image.height;
+    return image;
+  }
+  Image8 image = read_image8(camera.image_path);
+  if (image.width != camera.stored.width || image.height != camera.stored.height)
+    fail_file(camera.image_path, fmt::format("image is {}x{}, expected {} like the scene's cameras",
+                                             image.width, image.height, describe(camera.stored)));
+  source_intrinsics = camera.stored;
+  return image;
+}
+
+Image8 ViewImages::undistorted(const Camera& camera, const Image8& source,
+                               const Intrinsics& source_intrinsics) const {
+  const fs::path cached =
+      options_.undistort_cache_dir /
+      (undistort_key(camera.image_path, source_intrinsics, camera.distortion) + ".png");
+  std::error_code ec;
+  if (fs::is_regular_file(cached, ec)) {
+    try {
+      Image8 image = read_image8(cached);
+      if (image.width == source.width && image.height == source.height &&
+          image.channels == source.channels)
+        return image;
+    } catch (const Error& e) {
+      spdlog::warn("ignoring unreadable undistortion cache entry: {}", e.what());
+    }
+  }
+  Image8 image = undistort_image(source, source_intrinsics, camera.distortion);
+  try {
+    write_png(cached, image);
+  } catch (const Error& e) {
+    spdlog::warn("cannot cache the undistorted image ({}); continuing without the cache", e.what());
+  }
+  return image;
+}
+
+Image8 ViewImages::read8(const Camera& camera) const {
+  Intrinsics source_intrinsics;
+  Image8 image = read_source(camera, source_intrinsics);
+  if (camera.distortion.any()) image = undistorted(camera, image, source_intrinsics);
+  const Intrinsics& target = camera.intrinsics;
+  if (image.width != target.width || image.height != target.height)
+    image = resize_bicubic(image, target.width, target.height);
+  return image;
+}
+
+std::shared_ptr<const Image> ViewImages::rgb(const Camera& camera) {
+  const std::string key = camera.image_path.string();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (auto it = cache_.find(key); it != cache_.end()) {
+      lru_.splice(lru_.begin(), lru_, it->second.second);
+      return it->second.first;
+    }
+  }
+  auto image =
+      std::make_shared<const Image>(composite_rgb(read8(camera), scene_.background.data()));
+  const size_t bytes = image->data.size() * sizeof(float);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (bytes > options_.cache_bytes || cache_.count(key)) return image;
+  while (cached_bytes_ + bytes > options_.cache_bytes && !lru_.empty()) {
+    auto victim = cache_.find(lru_.back());
+    cached_bytes_ -= victim->second.first->data.size() * sizeof(float);
+    cache_.erase(victim);
+    lru_.pop_back();
+  }
+  lru_.push_front(key);
+  cache_.emplace(key, std::make_pair(image, lru_.begin()));
+  cached_bytes_ += bytes;
+  return image;
+}
+
+}  // namespace iesrgs

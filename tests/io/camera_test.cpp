@@ -1,0 +1,79 @@
+#include <gtest/gtest.h>
+
+#include "io/camera.hpp"
+#include "io/scene.hpp"
+
+namespace iesrgs {
+namespace {
+
+// Pixel coordinates of a world point (pixel centers at +0.5).
+std::pair<double, double> project(const Camera& camera, const Vec3& world) {
+  const Vec3 p = camera.rotation * world + camera.translation;
+  const Intrinsics& k = camera.intrinsics;
+  return {k.fx * p.x / p.z + k.cx, k.fy * p.y / p.z + k.cy};
+}
+
+TEST(Camera, OpenGlCameraToWorldBecomesOpenCvWorldToCamera) {
+  // An OpenGL camera at (0, 0, 4) looking down -z at the origin, y up.
+  const double c2w[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 4}, {0, 0, 0, 1}};
+  Camera camera;
+  opengl_c2w_to_opencv_w2c(c2w, camera.rotation, camera.translation);
+  camera.intrinsics = {100, 80, 50, 50, 50, 40};
+  EXPECT_NEAR(camera.center().z, 4, 1e-12);
+  const Vec3 origin_in_camera = camera.rotation * Vec3{} + camera.translation;
+  EXPECT_NEAR(origin_in_camera.z, 4, 1e-12);  // in front: OpenCV z forward
+  auto [u, v] = project(camera, {0, 0, 0});
+  EXPECT_NEAR(u, 50, 1e-9);
+  EXPECT_NEAR(v, 40, 1e-9);
+  // World +y is up for OpenGL, so it lands in the upper half of the image (smaller v).
+  std::tie(u, v) = project(camera, {0, 1, 0});
+  EXPECT_LT(v, 40);
+  std::tie(u, v) = project(camera, {1, 0, 0});
+  EXPECT_GT(u, 50);
+}
+
+TEST(Camera, ScalingKeepsTheFieldOfView) {
+  const Intrinsics k{200, 100, 180, 170, 100, 50};
+  const Intrinsics hr = k.scaled(4);
+  EXPECT_EQ(hr.width, 800);
+  EXPECT_EQ(hr.height, 400);
+  EXPECT_DOUBLE_EQ(hr.fx, 720);
+  EXPECT_DOUBLE_EQ(hr.cx, 400);
+  EXPECT_NEAR(hr.fov_x(), k.fov_x(), 1e-12);
+  EXPECT_NEAR(hr.fov_y(), k.fov_y(), 1e-12);
+  // A world point lands on the same relative image position at both resolutions.
+  Camera lr;
+  lr.intrinsics = k;
+  lr.translation = {0.1, -0.2, 3};
+  const Camera high = lr.scaled(4);
+  const auto [u, v] = project(lr, {0.3, 0.2, 0.5});
+  const auto [U, V] = project(high, {0.3, 0.2, 0.5});
+  EXPECT_NEAR(U, 4 * u, 1e-9);
+  EXPECT_NEAR(V, 4 * v, 1e-9);
+}
+
+TEST(Camera, DistortionModelMatchesOpenCv) {
+  const Distortion d{0.1, -0.05, 0.001, -0.002};
+  double xd, yd;
+  d.apply(0.3, -0.2, xd, yd);
+  const double r2 = 0.13, radial = 1 + 0.1 * r2 - 0.05 * r2 * r2;
+  EXPECT_NEAR(xd, 0.3 * radial + 2 * 0.001 * 0.3 * -0.2 + -0.002 * (r2 + 2 * 0.09), 1e-15);
+  EXPECT_NEAR(yd, -0.2 * radial + 0.001 * (r2 + 2 * 0.04) + 2 * -0.002 * 0.3 * -0.2, 1e-15);
+  EXPECT_FALSE(Distortion{}.any());
+}
+
+TEST(Scene, NormalizationAsGaussianSplatting) {
+  Scene scene;
+  for (double x : {-2.0, 0.0, 4.0}) {
+    Camera camera;
+    camera.translation = {-x, 0, 0};  // identity rotation: center = (x, 0, 0)
+    scene.cameras.push_back(camera);
+  }
+  scene.cameras.back().split = Split::Test;  // test cameras do not count
+  const SceneNormalization norm = scene.normalization();
+  EXPECT_NEAR(norm.center.x, -1, 1e-12);
+  EXPECT_NEAR(norm.radius, 1.1, 1e-12);
+}
+
+}  // namespace
+}  // namespace iesrgs

@@ -1,0 +1,94 @@
+#include <gtest/gtest.h>
+#include <stb/stb_image.h>
+
+#include "io/atomic_file.hpp"
+#include "io/image.hpp"
+#include "support/expect_error.hpp"
+#include "support/temp_dir.hpp"
+
+namespace iesrgs {
+namespace {
+
+using testing::error_message;
+using testing::TempDir;
+using testing::write_text;
+
+Image8 gradient(int w, int h, int c) {
+  Image8 image(w, h, c);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int k = 0; k < c; ++k) image.at(x, y, k) = uint8_t((x * 7 + y * 13 + k * 50) % 256);
+  return image;
+}
+
+TEST(Image, PngRoundTripKeepsEveryChannel) {
+  TempDir dir;
+  for (int channels = 1; channels <= 4; ++channels) {
+    const Image8 image = gradient(13, 7, channels);
+    const auto path = dir / ("g" + std::to_string(channels) + ".png");
+    write_png(path, image);
+    const Image8 back = read_image8(path);
+    EXPECT_EQ(back.channels, channels);
+    EXPECT_EQ(back.data, image.data);
+    const ImageHeader header = read_image_header(path);
+    EXPECT_EQ(header.width, 13);
+    EXPECT_EQ(header.height, 7);
+  }
+}
+
+TEST(Image, CompositeOverBackground) {
+  Image8 rgba(2, 1, 4);
+  rgba.data = {255, 0, 0, 255, /* opaque red */ 0, 0, 255, 0 /* transparent */};
+  const float white[3] = {1, 1, 1};
+  const Image rgb = composite_rgb(rgba, white);
+  EXPECT_FLOAT_EQ(rgb.at(0, 0, 0), 1.f);
+  EXPECT_FLOAT_EQ(rgb.at(0, 0, 1), 0.f);
+  EXPECT_FLOAT_EQ(rgb.at(1, 0, 0), 1.f);
+  EXPECT_FLOAT_EQ(rgb.at(1, 0, 2), 1.f);
+  Image8 half(1, 1, 4);
+  half.data = {0, 0, 0, 128};
+  EXPECT_NEAR(composite_rgb(half, white).at(0, 0, 0), 1 - 128 / 255.f, 1e-6);
+}
+
+TEST(Image, Png16IsReadBackExactly) {
+  TempDir dir;
+  std::vector<uint16_t> depth{0, 1, 256, 65535, 1234, 40000};
+  write_png16(dir / "d.png", depth, 3, 2);
+  int w, h, c;
+  stbi_us* pixels = stbi_load_16((dir / "d.png").c_str(), &w, &h, &c, 0);
+  ASSERT_NE(pixels, nullptr);
+  EXPECT_EQ(w, 3);
+  EXPECT_EQ(h, 2);
+  EXPECT_EQ(c, 1);
+  EXPECT_EQ(std::vector<uint16_t>(pixels, pixels + 6), depth);
+  stbi_image_free(pixels);
+}
+
+TEST(Image, ToEightBitRoundsAndClamps) {
+  Image image(4, 1, 1);
+  image.data = {-0.5f, 0.5f, 1.5f, 0.2f};
+  EXPECT_EQ(to_8bit(image).data, (std::vector<uint8_t>{0, 128, 255, 51}));
+}
+
+TEST(Image, MissingFileIsNamed) {
+  TempDir dir;
+  const std::string message = error_message([&] { read_image8(dir / "nope.png"); });
+  EXPECT_NE(message.find("nope.png: image not found"), std::string::npos) << message;
+}
+
+TEST(Image, CorruptFilesAreNamed) {
+  TempDir dir;
+  write_png(dir / "ok.png", gradient(64, 64, 3));
+  const std::string png = read_file(dir / "ok.png");
+  write_text(dir / "truncated.png", png.substr(0, png.size() / 2));
+  write_text(dir / "garbage.jpg", "this is not a JPEG at all");
+  write_text(dir / "empty.png", "");
+  for (const char* name : {"truncated.png", "garbage.jpg", "empty.png"}) {
+    const std::string message = error_message([&] { read_image8(dir / name); });
+    EXPECT_NE(message.find(std::string(name) + ": not a readable PNG/JPEG"), std::string::npos)
+        << message;
+  }
+}
+
+}  // namespace
+}  // namespace iesrgs

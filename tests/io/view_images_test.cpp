@@ -1,0 +1,113 @@
+#include <gtest/gtest.h>
+
+#include "io/view_images.hpp"
+#include "support/expect_error.hpp"
+#include "support/temp_dir.hpp"
+
+namespace iesrgs {
+namespace {
+
+using testing::error_message;
+using testing::TempDir;
+
+Image8 solid(int w, int h, std::vector<uint8_t> color) {
+  Image8 image(w, h, static_cast<int>(color.size()));
+  for (size_t i = 0; i < image.data.size(); ++i) image.data[i] = color[i % color.size()];
+  return image;
+}
+
+Camera camera_for(const std::filesystem::path& path, int w, int h) {
+  Camera camera;
+  camera.name = path.stem().string();
+  camera.image_path = path;
+  camera.stored = {w, h, double(w), double(w), w / 2.0, h / 2.0};
+  camera.intrinsics = camera.stored;
+  return camera;
+}
+
+struct Fixture {
+  TempDir dir;
+  Scene scene;
+  ViewImageOptions options;
+
+  Fixture() { options.undistort_cache_dir = dir / "cache"; }
+  const Camera& add(const std::string& name, const Image8& image) {
+    write_png(dir / "images" / name, image);
+    scene.cameras.push_back(camera_for(dir / "images" / name, image.width, image.height));
+    return scene.cameras.back();
+  }
+};
+
+TEST(ViewImages, CompositesRgbaOverTheSceneBackground) {
+  Fixture f;
+  f.scene.background = {0, 0, 1};
+  const Camera camera = f.add("a.png", solid(6, 4, {255, 0, 0, 0}));
+  ViewImages images(f.scene, f.options);
+  const auto rgb = images.rgb(camera);
+  ASSERT_EQ(rgb->channels, 3);
+  EXPECT_EQ(rgb->width, 6);
+  EXPECT_FLOAT_EQ(rgb->at(3, 2, 0), 0.f);
+  EXPECT_FLOAT_EQ(rgb->at(3, 2, 2), 1.f);
+}
+
+TEST(ViewImages, PrefersThePreDownscaledFolder) {
+  Fixture f;
+  Camera camera = f.add("a.png", solid(8, 8, {255, 0, 0}));
+  write_png(f.dir / "images_2" / "a.png", solid(4, 4, {0, 255, 0}));
+  f.scene.downscale = 2;
+  camera.intrinsics = camera.stored.scaled(0.5);
+  ViewImages images(f.scene, f.options);
+  const auto rgb = images.rgb(camera);
+  EXPECT_EQ(rgb->width, 4);
+  EXPECT_FLOAT_EQ(rgb->at(1, 1, 1), 1.f);  // green: the downscaled copy, not the original
+}
+
+TEST(ViewImages, ResizesWhenNoDownscaledCopyExists) {
+  Fixture f;
+  Camera camera = f.add("a.png", solid(8, 6, {10, 200, 30}));
+  f.scene.downscale = 2;
+  camera.intrinsics = camera.stored.scaled(0.5);
+  ViewImages images(f.scene, f.options);
+  const auto rgb = images.rgb(camera);
+  EXPECT_EQ(rgb->width, 4);
+  EXPECT_EQ(rgb->height, 3);
+  EXPECT_NEAR(rgb->at(2, 1, 1), 200 / 255.f, 1e-6);  // a constant image stays constant
+}
+
+TEST(ViewImages, WrongImageSizeNamesTheFile) {
+  Fixture f;
+  Camera camera = f.add("a.png", solid(8, 6, {1, 2, 3}));
+  camera.stored.width = 9;
+  ViewImages images(f.scene, f.options);
+  const std::string message = error_message([&] { images.rgb(camera); });
+  EXPECT_NE(message.find("a.png: image is 8x6, expected 9x6"), std::string::npos) << message;
+}
+
+TEST(ViewImages, KeepsAtMostTheCacheBudget) {
+  Fixture f;
+  const Camera a = f.add("a.png", solid(4, 4, {1, 2, 3}));
+  const Camera b = f.add("b.png", solid(4, 4, {4, 5, 6}));
+  f.options.cache_bytes = 4 * 4 * 3 * sizeof(float);  // room for exactly one image
+  ViewImages images(f.scene, f.options);
+  const auto first = images.rgb(a);
+  EXPECT_EQ(images.rgb(a), first);  // served from memory
+  images.rgb(b);                    // evicts a
+  EXPECT_NE(images.rgb(a), first);
+}
+
+TEST(ViewImages, UndistortsOnceIntoTheCache) {
+  Fixture f;
+  Camera camera = f.add("a.png", solid(16, 12, {9, 99, 199}));
+  camera.distortion = {0.05, 0, 0, 0};
+  ViewImages images(f.scene, f.options);
+  const Image8 first = images.read8(camera);
+  ASSERT_TRUE(std::filesystem::is_directory(f.options.undistort_cache_dir));
+  int cached = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(f.options.undistort_cache_dir))
+    cached += entry.path().extension() == ".png";
+  EXPECT_EQ(cached, 1);
+  EXPECT_EQ(images.read8(camera).data, first.data);
+}
+
+}  // namespace
+}  // namespace iesrgs
