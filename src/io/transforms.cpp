@@ -1,0 +1,343 @@
+#include "io/transforms.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <utility>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+
+namespace iesrgs {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Larger sides are corrupt values, not images anyone trains on; they would drive huge allocations.
+constexpr int kMaxImageSide = 1 << 16;
+// Poses are stored as text with float precision; real files are orthonormal to about 1e-6.
+constexpr double kRotationTolerance = 1e-3;
+
+// Where a value sits, so that every message names the file and, inside a frame, its index.
+struct Where {
+  const fs::path& file;
+  int frame = -1;  // -1: the top level
+
+  [[noreturn]] void fail(const std::string& problem) const {
+    if (frame < 0) fail_file(file, problem);
+    fail_file(file, fmt::format("frame {}: {}", frame, problem));
+  }
+};
+
+// A JSON value quoted and escaped for a one-line message.
+std::string quoted(const json& value) {
+  return value.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+json parse_object(const std::string& text, const fs::path& json_path) {
+  json document;
+  try {
+    document = json::parse(text);
+  } catch (const json::parse_error& e) {
+    // what() starts with an id such as "[json.exception.parse_error.101] ": keep what follows.
+    const std::string detail = e.what();
+    const size_t id_end = detail.find("] ");
+    fail_file(json_path, fmt::format("malformed JSON at byte {} ({})", e.byte,
+                                     detail.substr(id_end == std::string::npos ? 0 : id_end + 2)));
+  } catch (const json::exception& e) {  // e.g. a number too large for a double
+    fail_file(json_path, fmt::format("invalid JSON ({})", e.what()));
+  }
+  if (!document.is_object()) fail_file(json_path, "top level is not a JSON object");
+  return document;
+}
+
+const json* find(const json& object, const char* key) {
+  const auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+const json& require(const json& object, const char* key, const Where& where) {
+  const json* value = find(object, key);
+  if (!value) where.fail(fmt::format("missing \"{}\"", key));
+  return *value;
+}
+
+// JSON numbers are finite: the parser rejects overflowing literals.
+double to_number(const json& value, const char* key, const Where& where) {
+  if (!value.is_number()) where.fail(fmt::format("\"{}\" must be a number", key));
+  return value.get<double>();
+}
+
+int to_image_side(double side, const char* key, const Where& where) {
+  if (!(side >= 1 && side <= kMaxImageSide && side == std::floor(side)))
+    where.fail(fmt::format("\"{}\" must be an integer image size in [1, {}], got {}", key,
+                           kMaxImageSide, side));
+  return static_cast<int>(side);
+}
+
+double focal_from_angle(double angle, int side, const char* key, const Where& where) {
+  if (!(angle > 0 && angle < kPi))
+    where.fail(
+        fmt::format("\"{}\" must be a field of view in (0, pi) radians, got {}", key, angle));
+  const double focal = 0.5 * side / std::tan(0.5 * angle);
+  if (!std::isfinite(focal)) where.fail(fmt::format("\"{}\" is too small, got {}", key, angle));
+  return focal;
+}
+
+const json& read_frames(const json& document, const fs::path& json_path) {
+  const Where top{json_path};
+  const json& frames = require(document, "frames", top);
+  if (!frames.is_array()) top.fail("\"frames\" must be an array");
+  if (frames.empty()) top.fail("no frames");
+  for (size_t i = 0; i < frames.size(); ++i)
+    if (!frames[i].is_object()) Where{json_path, static_cast<int>(i)}.fail("not a JSON object");
+  return frames;
+}
+
+std::string read_file_path(const json& frame, const Where& where) {
+  const json& value = require(frame, "file_path", where);
+  if (!value.is_string() || value.get_ref<const std::string&>().empty())
+    where.fail("\"file_path\" must be a non-empty string");
+  const std::string& path = value.get_ref<const std::string&>();
+  // Control characters would break one-line messages and are no real file name.
+  if (std::any_of(path.begin(), path.end(), [](unsigned char c) { return c < 0x20; }))
+    where.fail("\"file_path\" contains control characters");
+  return path;
+}
+
+bool read_4x4(const json& value, double matrix[4][4]) {
+  if (!value.is_array() || value.size() != 4) return false;
+  for (int r = 0; r < 4; ++r) {
+    const json& row = value[r];
+    if (!row.is_array() || row.size() != 4) return false;
+    for (int c = 0; c < 4; ++c) {
+      if (!row[c].is_number()) return false;
+      matrix[r][c] = row[c].get<double>();
+    }
+  }
+  return true;
+}
+
+// Orthonormal columns and a positive determinant. The negated comparisons also reject the NaN that
+// huge entries produce.
+bool is_rotation(const double m[4][4]) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double dot = m[0][i] * m[0][j] + m[1][i] * m[1][j] + m[2][i] * m[2][j];
+      if (!(std::abs(dot - (i == j ? 1 : 0)) <= kRotationTolerance)) return false;
+    }
+  const Vec3 x{m[0][0], m[1][0], m[2][0]}, y{m[0][1], m[1][1], m[2][1]},
+      z{m[0][2], m[1][2], m[2][2]};
+  return x.cross(y).dot(z) > 0;
+}
+
+void read_pose(const json& frame, const Where& where, Camera& camera) {
+  double c2w[4][4];
+  if (!read_4x4(require(frame, "transform_matrix", where), c2w))
+    where.fail("\"transform_matrix\" must be a 4x4 array of numbers");
+  if (!is_rotation(c2w)) where.fail("\"transform_matrix\" does not hold a rotation");
+  opengl_c2w_to_opencv_w2c(c2w, camera.rotation, camera.translation);
+  const Vec3& t = camera.translation;
+  if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z))
+    where.fail("\"transform_matrix\" position is out of range");
+}
+
+// One frame's posed camera, named after its image; intrinsics are left to the caller.
+Camera posed_camera(const json& frame, const Where& where, const fs::path& image_path) {
+  Camera camera;
+  camera.image_path = image_path;
+  camera.name = image_path.stem().string();
+  read_pose(frame, where, camera);
+  return camera;
+}
+
+Intrinsics centered_intrinsics(int width, int height, double fx, double fy) {
+  return {width, height, fx, fy, width / 2.0, height / 2.0};
+}
+
+void require_images_exist(const std::vector<Camera>& cameras, const fs::path& json_path) {
+  for (const Camera& camera : cameras) {
+    std::error_code ec;
+    if (!fs::is_regular_file(camera.image_path, ec))
+      fail_file(json_path, fmt::format("image {} not found", camera.image_path.string()));
+  }
+}
+
+// Blender frames name images without their ".png" extension.
+fs::path blender_image_path(const fs::path& dir, const std::string& file_path) {
+  fs::path path = dir / file_path;
+  if (!path.has_extension()) path += ".png";
+  return path.lexically_normal();
+}
+
+// A frame's keys override the scene-wide ones: nerfstudio and instant-ngp allow per-frame
+// intrinsics.
+class FrameKeys {
+ public:
+  FrameKeys(const json& scene, const json& frame, const fs::path& json_path, int index)
+      : scene_(scene), frame_(frame), json_path_(json_path), index_(index) {}
+
+  const json* find(const char* key) const {
+    const json* value = iesrgs::find(frame_, key);
+    return value ? value : iesrgs::find(scene_, key);
+  }
+  // Messages about `key` name the frame only when the value came from it.
+  Where where(const char* key) const { return {json_path_, frame_.contains(key) ? index_ : -1}; }
+  Where frame() const { return {json_path_, index_}; }
+
+  std::optional<double> number(const char* key) const {
+    const json* value = find(key);
+    if (!value) return std::nullopt;
+    return to_number(*value, key, where(key));
+  }
+  std::optional<std::string> string(const char* key) const {
+    const json* value = find(key);
+    if (!value) return std::nullopt;
+    if (!value->is_string()) where(key).fail(fmt::format("\"{}\" must be a string", key));
+    return value->get<std::string>();
+  }
+
+ private:
+  const json& scene_;
+  const json& frame_;
+  const fs::path& json_path_;
+  int index_;
+};
+
+// `focal_key` (in pixels) or else `angle_key` (the field of view across `side` pixels).
+std::optional<double> read_focal(const FrameKeys& keys, const char* focal_key,
+                                 const char* angle_key, int side) {
+  if (const std::optional<double> focal = keys.number(focal_key)) {
+    if (!(*focal > 0))
+      keys.where(focal_key).fail(fmt::format("\"{}\" must be positive", focal_key));
+    return focal;
+  }
+  if (const std::optional<double> angle = keys.number(angle_key))
+    return focal_from_angle(*angle, side, angle_key, keys.where(angle_key));
+  return std::nullopt;
+}
+
+Intrinsics nerfstudio_intrinsics(const FrameKeys& keys, const fs::path& image_path,
+                                 const ImageHeaderReader& read_header) {
+  const std::optional<double> w = keys.number("w"), h = keys.number("h");
+  ImageHeader header;
+  if (!w || !h) header = read_header(image_path);
+  const int width = w ? to_image_side(*w, "w", keys.where("w")) : header.width;
+  const int height = h ? to_image_side(*h, "h", keys.where("h")) : header.height;
+  const std::optional<double> fx = read_focal(keys, "fl_x", "camera_angle_x", width);
+  if (!fx) keys.frame().fail("missing \"fl_x\" (or \"camera_angle_x\")");
+  // instant-ngp: a single field of view means square pixels.
+  const double fy = read_focal(keys, "fl_y", "camera_angle_y", height).value_or(*fx);
+  Intrinsics k = centered_intrinsics(width, height, *fx, fy);
+  k.cx = keys.number("cx").value_or(k.cx);
+  k.cy = keys.number("cy").value_or(k.cy);
+  return k;
+}
+
+Distortion nerfstudio_distortion(const FrameKeys& keys) {
+  const bool has_coefficients = keys.find("k1") || keys.find("k2") || keys.find("p1") ||
+                                keys.find("p2") || keys.find("k3") || keys.find("k4");
+  const std::string model =
+      keys.string("camera_model").value_or(has_coefficients ? "OPENCV" : "PINHOLE");
+  if (model == "PINHOLE") return {};
+  if (model != "OPENCV")
+    keys.where("camera_model")
+        .fail(fmt::format("unsupported \"camera_model\" {} (supported: PINHOLE, OPENCV)",
+                          quoted(json(model))));
+  for (const char* key : {"k3", "k4"})
+    if (keys.number(key).value_or(0) != 0)
+      keys.where(key).fail(fmt::format("\"{}\" is not supported (OPENCV uses k1 k2 p1 p2)", key));
+  return {keys.number("k1").value_or(0), keys.number("k2").value_or(0),
+          keys.number("p1").value_or(0), keys.number("p2").value_or(0)};
+}
+
+// Cameras paired with their file_path as written, in file order.
+std::vector<std::pair<std::string, Camera>> nerfstudio_cameras(
+    const json& document, const fs::path& json_path, const ImageHeaderReader& read_header) {
+  const json& frames = read_frames(document, json_path);
+  std::vector<std::pair<std::string, Camera>> cameras;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const FrameKeys keys(document, frames[i], json_path, static_cast<int>(i));
+    std::string file_path = read_file_path(frames[i], keys.frame());
+    Camera camera = posed_camera(frames[i], keys.frame(),
+                                 (json_path.parent_path() / file_path).lexically_normal());
+    camera.stored = camera.intrinsics = nerfstudio_intrinsics(keys, camera.image_path, read_header);
+    camera.distortion = nerfstudio_distortion(keys);
+    cameras.emplace_back(std::move(file_path), std::move(camera));
+  }
+  return cameras;
+}
+
+}  // namespace
+
+std::vector<Camera> parse_blender_transforms(const std::string& text, const fs::path& json_path,
+                                             Split split, const ImageHeaderReader& read_header) {
+  const json document = parse_object(text, json_path);
+  const Where top{json_path};
+  const double angle_x = to_number(require(document, "camera_angle_x", top), "camera_angle_x", top);
+  const json& frames = read_frames(document, json_path);
+  std::vector<Camera> cameras;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const Where where{json_path, static_cast<int>(i)};
+    const fs::path image_path =
+        blender_image_path(json_path.parent_path(), read_file_path(frames[i], where));
+    cameras.push_back(posed_camera(frames[i], where, image_path));
+    cameras.back().split = split;
+  }
+  const ImageHeader header = read_header(cameras.front().image_path);
+  const double focal = focal_from_angle(angle_x, header.width, "camera_angle_x", top);
+  const Intrinsics k = centered_intrinsics(header.width, header.height, focal, focal);
+  for (Camera& camera : cameras) camera.stored = camera.intrinsics = k;
+  return cameras;
+}
+
+Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_path,
+                                  const SceneOptions& options,
+                                  const ImageHeaderReader& read_header) {
+  if (options.test_every < 1) fail("test_every must be at least 1, got {}", options.test_every);
+  std::vector<std::pair<std::string, Camera>> cameras =
+      nerfstudio_cameras(parse_object(text, json_path), json_path, read_header);
+  // The split must not depend on the order frames happen to be listed in.
+  std::stable_sort(cameras.begin(), cameras.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  Scene scene;
+  scene.format = "nerfstudio";
+  scene.synthetic = false;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    Camera& camera = cameras[i].second;
+    camera.split = i % options.test_every == 0 ? Split::Test : Split::Train;
+    scene.cameras.push_back(std::move(camera));
+  }
+  return scene;
+}
+
+Scene read_blender_scene(const fs::path& root, const SceneOptions&) {
+  Scene scene;
+  scene.format = "blender";
+  scene.synthetic = true;
+  for (const auto& [name, split] : {std::pair{"transforms_train.json", Split::Train},
+                                    std::pair{"transforms_test.json", Split::Test}}) {
+    const fs::path json_path = root / name;
+    std::error_code ec;
+    if (split == Split::Test && !fs::exists(json_path, ec)) continue;
+    const std::vector<Camera> cameras =
+        parse_blender_transforms(read_file(json_path), json_path, split, read_image_header);
+    require_images_exist(cameras, json_path);
+    scene.cameras.insert(scene.cameras.end(), cameras.begin(), cameras.end());
+  }
+  return scene;
+}
+
+Scene read_nerfstudio_scene(const fs::path& transforms_json, const SceneOptions& options) {
+  Scene scene = parse_nerfstudio_transforms(read_file(transforms_json), transforms_json, options,
+                                            read_image_header);
+  require_images_exist(scene.cameras, transforms_json);
+  return scene;
+}
+
+}  // namespace iesrgs

@@ -1,0 +1,39 @@
+#pragma once
+// transforms.json readers: NeRF-Synthetic / Blender and nerfstudio / instant-ngp.
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "io/image.hpp"
+#include "io/scene.hpp"
+
+namespace iesrgs {
+
+// `root` holds transforms_train.json and, optionally, transforms_test.json with camera_angle_x
+// and RGBA images; transforms_val.json is ignored, as 3DGS does. The image size is read from the
+// header of each file's first image.
+Scene read_blender_scene(const std::filesystem::path& root, const SceneOptions& options);
+
+// `transforms_json` in the nerfstudio / instant-ngp convention: per-scene or per-frame
+// intrinsics (fl_x, fl_y, cx, cy, w, h or camera_angle_x/y), camera models PINHOLE and OPENCV
+// (k1 k2 p1 p2). Frames sorted by file_path; every `test_every`-th one, starting with the first,
+// is held out for test (LLFF convention).
+Scene read_nerfstudio_scene(const std::filesystem::path& transforms_json,
+                            const SceneOptions& options);
+
+// The parsers behind the readers, on JSON text already in memory (so they can be fuzzed without
+// files): `json_path` names the source in messages and anchors relative image paths. Images are
+// only touched through `read_header`, for sizes the JSON does not give; whether every image exists
+// is left to the readers above.
+using ImageHeaderReader = std::function<ImageHeader(const std::filesystem::path&)>;
+
+// One transforms_<split>.json of a Blender scene.
+std::vector<Camera> parse_blender_transforms(const std::string& text,
+                                             const std::filesystem::path& json_path, Split split,
+                                             const ImageHeaderReader& read_header);
+Scene parse_nerfstudio_transforms(const std::string& text, const std::filesystem::path& json_path,
+                                  const SceneOptions& options,
+                                  const ImageHeaderReader& read_header);
+
+}  // namespace iesrgs

@@ -1,0 +1,14 @@
+#pragma once
+// Undistortion of OpenCV-model (k1 k2 p1 p2) images to a pinhole image.
+#include "io/camera.hpp"
+#include "io/image.hpp"
+
+namespace iesrgs {
+
+// Resamples `image` (taken with `intrinsics` and `distortion`) into the pinhole camera with the
+// same intrinsics: each output pixel is projected through the distortion and sampled bilinearly
+// from the input; samples outside the input are clamped to its border.
+Image8 undistort_image(const Image8& image, const Intrinsics& intrinsics,
+                       const Distortion& distortion);
+
+}  // namespace iesrgs
