@@ -1,0 +1,230 @@
+#include "io/colmap.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/colmap_codec.hpp"
+
+namespace iesrgs {
+
+namespace fs = std::filesystem;
+
+namespace codec = colmap_codec;
+
+std::map<uint32_t, ColmapCamera> parse_colmap_cameras(std::string_view bytes,
+                                                      ColmapEncoding encoding,
+                                                      const fs::path& source) {
+  return encoding == ColmapEncoding::Binary ? codec::decode_cameras_binary(bytes, source)
+                                            : codec::decode_cameras_text(bytes, source);
+}
+
+std::map<uint32_t, ColmapImage> parse_colmap_images(std::string_view bytes, ColmapEncoding encoding,
+                                                    const fs::path& source) {
+  return encoding == ColmapEncoding::Binary ? codec::decode_images_binary(bytes, source)
+                                            : codec::decode_images_text(bytes, source);
+}
+
+std::vector<ColmapPoint> parse_colmap_points(std::string_view bytes, ColmapEncoding encoding,
+                                             const fs::path& source) {
+  return encoding == ColmapEncoding::Binary ? codec::decode_points_binary(bytes, source)
+                                            : codec::decode_points_text(bytes, source);
+}
+
+namespace {
+
+// The three files of a model in one encoding.
+struct ModelFiles {
+  fs::path cameras, images, points;
+
+  ModelFiles(const fs::path& dir, ColmapEncoding encoding) {
+    const char* extension = encoding == ColmapEncoding::Binary ? ".bin" : ".txt";
+    cameras = dir / (std::string("cameras") + extension);
+    images = dir / (std::string("images") + extension);
+    points = dir / (std::string("points3D") + extension);
+  }
+};
+
+ColmapEncoding stored_encoding(const fs::path& dir) {
+  std::error_code ec;
+  if (fs::exists(dir / "cameras.bin", ec)) return ColmapEncoding::Binary;
+  if (fs::exists(dir / "cameras.txt", ec)) return ColmapEncoding::Text;
+  fail_file(dir, "no COLMAP model here (neither cameras.bin nor cameras.txt)");
+}
+
+void check_camera_references(const ColmapModel& model, const fs::path& images_file) {
+  for (const auto& [id, image] : model.images)
+    if (!model.cameras.count(image.camera_id))
+      fail_file(images_file,
+                fmt::format("image {} ('{}') refers to camera {}, which is not defined", id,
+                            image.name, image.camera_id));
+}
+
+// All three files are encoded before any is written, so a model that cannot be written leaves
+// no partial model behind.
+void write_colmap_model(const fs::path& dir, const ColmapModel& model, ColmapEncoding encoding) {
+  const ModelFiles files(dir, encoding);
+  std::string cameras, images, points;
+  if (encoding == ColmapEncoding::Binary) {
+    cameras = codec::encode_cameras_binary(model.cameras, files.cameras);
+    images = codec::encode_images_binary(model.images, files.images);
+    points = codec::encode_points_binary(model.points);
+  } else {
+    cameras = codec::encode_cameras_text(model.cameras, files.cameras);
+    images = codec::encode_images_text(model.images, files.images);
+    points = codec::encode_points_text(model.points);
+  }
+  write_file_atomically(files.cameras, cameras);
+  write_file_atomically(files.images, images);
+  write_file_atomically(files.points, points);
+}
+
+}  // namespace
+
+ColmapModel read_colmap_model(const fs::path& dir) {
+  const ColmapEncoding encoding = stored_encoding(dir);
+  const ModelFiles files(dir, encoding);
+  ColmapModel model;
+  model.cameras = parse_colmap_cameras(read_file(files.cameras), encoding, files.cameras);
+  model.images = parse_colmap_images(read_file(files.images), encoding, files.images);
+  model.points = parse_colmap_points(read_file(files.points), encoding, files.points);
+  check_camera_references(model, files.images);
+  return model;
+}
+
+void write_colmap_model_binary(const fs::path& dir, const ColmapModel& model) {
+  write_colmap_model(dir, model, ColmapEncoding::Binary);
+}
+
+void write_colmap_model_text(const fs::path& dir, const ColmapModel& model) {
+  write_colmap_model(dir, model, ColmapEncoding::Text);
+}
+
+namespace {
+
+// Larger is a corrupt file, not a photograph (and would overflow int pixel counts).
+constexpr uint64_t kMaxImageSide = 1 << 16;
+
+// Where the pinhole and distortion terms sit in a supported model's parameters; -1: the model
+// has no such term (zero). The SIMPLE_ models share one focal length between x and y.
+struct PinholeLayout {
+  std::string_view model;
+  int fx, fy, cx, cy, k1, k2, p1, p2;
+};
+
+constexpr PinholeLayout kSupportedModels[] = {
+    {"SIMPLE_PINHOLE", 0, 0, 1, 2, -1, -1, -1, -1},
+    {"PINHOLE", 0, 1, 2, 3, -1, -1, -1, -1},
+    {"SIMPLE_RADIAL", 0, 0, 1, 2, 3, -1, -1, -1},
+    {"RADIAL", 0, 0, 1, 2, 3, 4, -1, -1},
+    {"OPENCV", 0, 1, 2, 3, 4, 5, 6, 7},
+};
+
+const PinholeLayout& supported_layout(const ColmapCamera& camera, const fs::path& cameras_file) {
+  std::string supported;
+  for (const PinholeLayout& layout : kSupportedModels) {
+    if (layout.model == camera.model) return layout;
+    supported += (supported.empty() ? "" : ", ") + std::string(layout.model);
+  }
+  fail_file(cameras_file,
+            fmt::format("camera {} uses the unsupported model {} (supported: {}; undistort the "
+                        "images with COLMAP's image_undistorter first)",
+                        camera.id, camera.model, supported));
+}
+
+struct Lens {
+  Intrinsics intrinsics;
+  Distortion distortion;
+};
+
+// Parameter counts were checked against the model when the file was parsed. COLMAP's principal
+// point already follows Intrinsics' convention (image corner at 0, pixel centers at +0.5).
+Lens lens_of(const ColmapCamera& camera, const fs::path& cameras_file) {
+  const PinholeLayout& layout = supported_layout(camera, cameras_file);
+  const auto param = [&camera](int index) { return index < 0 ? 0.0 : camera.params[index]; };
+  if (camera.width < 1 || camera.width > kMaxImageSide || camera.height < 1 ||
+      camera.height > kMaxImageSide)
+    fail_file(cameras_file, fmt::format("camera {}: implausible image size {}x{}", camera.id,
+                                        camera.width, camera.height));
+  Lens lens;
+  lens.intrinsics = {static_cast<int>(camera.width),
+                     static_cast<int>(camera.height),
+                     param(layout.fx),
+                     param(layout.fy),
+                     param(layout.cx),
+                     param(layout.cy)};
+  if (!(lens.intrinsics.fx > 0 && lens.intrinsics.fy > 0))
+    fail_file(cameras_file, fmt::format("camera {}: focal length must be positive", camera.id));
+  lens.distortion = {param(layout.k1), param(layout.k2), param(layout.p1), param(layout.p2)};
+  return lens;
+}
+
+Camera camera_of(const ColmapImage& image, const Lens& lens, const fs::path& root,
+                 const fs::path& images_file) {
+  const double norm = std::sqrt(image.qw * image.qw + image.qx * image.qx + image.qy * image.qy +
+                                image.qz * image.qz);
+  if (!(norm > 0 && std::isfinite(norm)))
+    fail_file(images_file,
+              fmt::format("image '{}': rotation quaternion cannot be normalized", image.name));
+  Camera camera;
+  camera.name = fs::path(image.name).stem().string();
+  camera.image_path = root / "images" / image.name;
+  camera.stored = lens.intrinsics;
+  camera.intrinsics = lens.intrinsics;
+  camera.distortion = lens.distortion;
+  // COLMAP normalizes quaternions on read; so do we.
+  camera.rotation =
+      quat_to_rotation(image.qw / norm, image.qx / norm, image.qy / norm, image.qz / norm);
+  camera.translation = {image.tx, image.ty, image.tz};
+  return camera;
+}
+
+PointCloud point_cloud_of(const std::vector<ColmapPoint>& points) {
+  PointCloud cloud;
+  cloud.positions.reserve(points.size());
+  cloud.colors.reserve(points.size());
+  for (const ColmapPoint& point : points) {
+    cloud.positions.push_back({point.x, point.y, point.z});
+    cloud.colors.push_back({point.r, point.g, point.b});
+  }
+  return cloud;
+}
+
+fs::path model_dir(const fs::path& root) {
+  std::error_code ec;
+  const fs::path first = root / "sparse" / "0";
+  return fs::is_directory(first, ec) ? first : root / "sparse";
+}
+
+}  // namespace
+
+Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
+  if (options.test_every < 1) fail("--test-every must be at least 1, got {}", options.test_every);
+  const fs::path dir = model_dir(root);
+  const ColmapModel model = read_colmap_model(dir);
+  const ModelFiles files(dir, stored_encoding(dir));
+
+  std::map<uint32_t, Lens> lenses;
+  for (const auto& [id, camera] : model.cameras) lenses[id] = lens_of(camera, files.cameras);
+
+  std::vector<const ColmapImage*> images;
+  for (const auto& [id, image] : model.images) images.push_back(&image);
+  // Stable: images of equal names keep their id order, so the split never depends on the sort.
+  std::stable_sort(images.begin(), images.end(),
+                   [](const ColmapImage* a, const ColmapImage* b) { return a->name < b->name; });
+
+  Scene scene;
+  scene.root = root;
+  scene.format = "colmap";
+  scene.synthetic = false;
+  for (size_t i = 0; i < images.size(); ++i) {
+    Camera camera = camera_of(*images[i], lenses.at(images[i]->camera_id), root, files.images);
+    camera.split = i % options.test_every == 0 ? Split::Test : Split::Train;
+    scene.cameras.push_back(std::move(camera));
+  }
+  scene.points = point_cloud_of(model.points);
+  return scene;
+}
+
+}  // namespace iesrgs
