@@ -1,0 +1,475 @@
+#include "io/ply.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cfloat>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+
+namespace iesrgs {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+              "binary PLY values are copied as they are, which needs a little-endian host");
+
+constexpr int kMaxShDegree = 3;
+constexpr std::string_view kRestPrefix = "f_rest_";
+constexpr char kFilterName[] = "filter_3D";
+
+size_t rest_per_channel(int sh_degree) {
+  return size_t((sh_degree + 1) * (sh_degree + 1) - 1);
+}
+
+// Where one PLY property lives in a SplatCloud: (cloud.*field)[gaussian * width + offset]. The
+// normals have no field: written as zeros, skipped when read.
+struct Slot {
+  std::string name;
+  std::vector<float> SplatCloud::*field = nullptr;
+  size_t width = 0, offset = 0;
+};
+
+void add_slots(std::vector<Slot>& slots, std::initializer_list<const char*> names,
+               std::vector<float> SplatCloud::*field) {
+  size_t offset = 0;
+  for (const char* name : names) slots.push_back({name, field, names.size(), offset++});
+}
+
+// Every property in 3DGS's file order.
+std::vector<Slot> layout(int sh_degree, bool with_filter_3d) {
+  std::vector<Slot> slots;
+  add_slots(slots, {"x", "y", "z"}, &SplatCloud::positions);
+  add_slots(slots, {"nx", "ny", "nz"}, nullptr);
+  add_slots(slots, {"f_dc_0", "f_dc_1", "f_dc_2"}, &SplatCloud::sh_dc);
+  // 3DGS flattens its (N, 3, K-1) transpose of features_rest: f_rest_j is channel j / (K-1),
+  // coefficient j % (K-1).
+  const size_t rest = rest_per_channel(sh_degree);
+  for (size_t j = 0; j < 3 * rest; ++j)
+    slots.push_back({std::string(kRestPrefix) + std::to_string(j), &SplatCloud::sh_rest, 3 * rest,
+                     (j % rest) * 3 + j / rest});
+  add_slots(slots, {"opacity"}, &SplatCloud::opacity);
+  add_slots(slots, {"scale_0", "scale_1", "scale_2"}, &SplatCloud::log_scales);
+  add_slots(slots, {"rot_0", "rot_1", "rot_2", "rot_3"}, &SplatCloud::rotations);
+  if (with_filter_3d) add_slots(slots, {kFilterName}, &SplatCloud::filter_3d);
+  return slots;
+}
+
+// ---- writing ----
+
+// The cloud's layout, after checking that its arrays match it.
+std::vector<Slot> checked_layout(const SplatCloud& cloud, const fs::path& path) {
+  if (cloud.sh_degree < 0 || cloud.sh_degree > kMaxShDegree)
+    fail_file(path, fmt::format("SH degree {} is outside 0..{}", cloud.sh_degree, kMaxShDegree));
+  std::vector<Slot> slots = layout(cloud.sh_degree, cloud.has_filter_3d());
+  const size_t count = cloud.size();
+  for (const Slot& slot : slots) {
+    if (!slot.field || slot.offset != 0) continue;
+    const size_t size = (cloud.*slot.field).size();
+    if (size != count * slot.width)
+      fail_file(path, fmt::format("the array of '{}' holds {} values, expected {} for {} Gaussians",
+                                  slot.name, size, count * slot.width, count));
+  }
+  return slots;
+}
+
+std::string header_text(size_t count, const std::vector<Slot>& slots) {
+  std::string text =
+      fmt::format("ply\nformat binary_little_endian 1.0\nelement vertex {}\n", count);
+  for (const Slot& slot : slots) text += "property float " + slot.name + "\n";
+  return text + "end_header\n";
+}
+
+void write_body(std::ostream& out, const SplatCloud& cloud, const std::vector<Slot>& slots,
+                const fs::path& path) {
+  std::vector<float> row(slots.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    for (size_t p = 0; p < slots.size(); ++p) {
+      const Slot& slot = slots[p];
+      row[p] = slot.field ? (cloud.*slot.field)[i * slot.width + slot.offset] : 0.f;
+      if (!std::isfinite(row[p]))
+        fail_file(path, fmt::format("Gaussian {}: '{}' is not finite", i, slot.name));
+    }
+    out.write(reinterpret_cast<const char*>(row.data()),
+              std::streamsize(row.size() * sizeof(float)));
+  }
+}
+
+// log(exp(a) + exp(b)) without overflow; exact when one side is -inf.
+double log_add_exp(double a, double b) {
+  const double hi = std::max(a, b), lo = std::min(a, b);
+  if (hi == -std::numeric_limits<double>::infinity()) return hi;
+  return hi + std::log1p(std::exp(lo - hi));
+}
+
+double softplus(double x) {
+  return log_add_exp(0, x);
+}
+
+// logit(sigmoid(logit_p) * exp(log_c)) for log_c <= 0, in log space so that it stays finite when
+// the product is close to 1 and returns logit_p unchanged when log_c is 0.
+double scaled_logit(double logit_p, double log_c) {
+  const double log_p = log_c - softplus(-logit_p);
+  const double log_one_minus_p =
+      log_add_exp(std::log(-std::expm1(log_c)), log_c - softplus(logit_p));
+  return log_p - log_one_minus_p;
+}
+
+// Mip-Splatting's 3D filter folded into the scales and opacity, in log space: log of
+// sqrt(s^2 + f^2) is half of log_add_exp(2 log s, 2 log f).
+SplatCloud bake_filter_3d(SplatCloud cloud) {
+  for (size_t i = 0; i < cloud.filter_3d.size(); ++i) {
+    const double log_filter = std::log(std::fabs(double(cloud.filter_3d[i])));
+    double log_opacity_factor = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      float& log_scale = cloud.log_scales[3 * i + k];
+      const double widened = 0.5 * log_add_exp(2.0 * log_scale, 2.0 * log_filter);
+      log_opacity_factor += log_scale - widened;
+      log_scale = float(widened);
+    }
+    cloud.opacity[i] = float(scaled_logit(cloud.opacity[i], log_opacity_factor));
+  }
+  cloud.filter_3d.clear();
+  return cloud;
+}
+
+// ---- reading ----
+
+enum class Scalar { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+
+std::optional<Scalar> scalar_named(std::string_view name) {
+  static const std::pair<std::string_view, Scalar> kNames[] = {
+      {"char", Scalar::kInt8},      {"int8", Scalar::kInt8},       {"uchar", Scalar::kUint8},
+      {"uint8", Scalar::kUint8},    {"short", Scalar::kInt16},     {"int16", Scalar::kInt16},
+      {"ushort", Scalar::kUint16},  {"uint16", Scalar::kUint16},   {"int", Scalar::kInt32},
+      {"int32", Scalar::kInt32},    {"uint", Scalar::kUint32},     {"uint32", Scalar::kUint32},
+      {"float", Scalar::kFloat32},  {"float32", Scalar::kFloat32}, {"double", Scalar::kFloat64},
+      {"float64", Scalar::kFloat64}};
+  for (const auto& [text, scalar] : kNames)
+    if (text == name) return scalar;
+  return std::nullopt;
+}
+
+size_t scalar_size(Scalar scalar) {
+  switch (scalar) {
+    case Scalar::kInt8:
+    case Scalar::kUint8:
+      return 1;
+    case Scalar::kInt16:
+    case Scalar::kUint16:
+      return 2;
+    case Scalar::kInt32:
+    case Scalar::kUint32:
+    case Scalar::kFloat32:
+      return 4;
+    case Scalar::kFloat64:
+      return 8;
+  }
+  return 0;
+}
+
+template <typename T>
+double load(const char* bytes) {
+  T value;
+  std::memcpy(&value, bytes, sizeof(T));
+  return double(value);
+}
+
+double load_scalar(const char* bytes, Scalar scalar) {
+  switch (scalar) {
+    case Scalar::kInt8:
+      return load<int8_t>(bytes);
+    case Scalar::kUint8:
+      return load<uint8_t>(bytes);
+    case Scalar::kInt16:
+      return load<int16_t>(bytes);
+    case Scalar::kUint16:
+      return load<uint16_t>(bytes);
+    case Scalar::kInt32:
+      return load<int32_t>(bytes);
+    case Scalar::kUint32:
+      return load<uint32_t>(bytes);
+    case Scalar::kFloat32:
+      return load<float>(bytes);
+    case Scalar::kFloat64:
+      return load<double>(bytes);
+  }
+  return 0;
+}
+
+struct Property {
+  std::string name;
+  Scalar type;
+};
+
+struct Header {
+  bool ascii = false;
+  uint64_t vertex_count = 0;
+  std::vector<Property> properties;  // of the vertex element
+  size_t body_offset = 0;
+};
+
+// A token from the file made safe to quote in a one-line message.
+std::string quote_token(std::string_view token) {
+  constexpr size_t kMaxQuoted = 40;
+  std::string text(token.substr(0, kMaxQuoted));
+  for (char& c : text)
+    if (!std::isprint(static_cast<unsigned char>(c))) c = '?';
+  return "'" + text + (token.size() > kMaxQuoted ? "...'" : "'");
+}
+
+std::vector<std::string_view> split_words(std::string_view line) {
+  std::vector<std::string_view> words;
+  size_t pos = 0;
+  while (pos < line.size()) {
+    const size_t start = line.find_first_not_of(" \t\r", pos);
+    if (start == std::string_view::npos) break;
+    pos = std::min(line.find_first_of(" \t\r", start), line.size());
+    words.push_back(line.substr(start, pos - start));
+  }
+  return words;
+}
+
+// Reads the header line by line, up to and including end_header, where the body starts.
+class HeaderParser {
+ public:
+  HeaderParser(std::string_view bytes, const fs::path& name) : bytes_(bytes), name_(name) {}
+
+  Header parse() {
+    if (next_line() != std::vector<std::string_view>{"ply"})
+      fail_file(name_, "not a PLY file (the first line is not 'ply')");
+    while (true) {
+      const std::vector<std::string_view> words = next_line();
+      if (words.empty() || words[0] == "comment" || words[0] == "obj_info") continue;
+      if (words[0] == "end_header") break;
+      if (words[0] == "format") {
+        parse_format(words);
+      } else if (words[0] == "element") {
+        parse_element(words);
+      } else if (words[0] == "property") {
+        parse_property(words);
+      } else {
+        fail_line("unknown header keyword " + quote_token(words[0]));
+      }
+    }
+    if (!format_seen_) fail_file(name_, "the header has no format line");
+    if (!vertex_seen_) fail_file(name_, "the header has no vertex element");
+    header_.body_offset = pos_;
+    return header_;
+  }
+
+ private:
+  std::vector<std::string_view> next_line() {
+    const size_t end = bytes_.find('\n', pos_);
+    if (end == std::string_view::npos) fail_file(name_, "truncated header (no end_header line)");
+    const std::string_view line = bytes_.substr(pos_, end - pos_);
+    pos_ = end + 1;
+    ++line_number_;
+    return split_words(line);
+  }
+
+  [[noreturn]] void fail_line(const std::string& problem) const {
+    fail_file(name_, fmt::format("header line {}: {}", line_number_, problem));
+  }
+
+  void parse_format(const std::vector<std::string_view>& words) {
+    if (words.size() != 3 || words[2] != "1.0") fail_line("expected 'format <type> 1.0'");
+    if (words[1] == "binary_big_endian")
+      fail_line("binary_big_endian PLY files are not supported (use binary_little_endian)");
+    if (words[1] != "ascii" && words[1] != "binary_little_endian")
+      fail_line("unknown format " + quote_token(words[1]));
+    header_.ascii = words[1] == "ascii";
+    format_seen_ = true;
+  }
+
+  void parse_element(const std::vector<std::string_view>& words) {
+    if (words.size() != 3) fail_line("expected 'element <name> <count>'");
+    in_vertex_ = !vertex_seen_;
+    if (!in_vertex_) return;  // later elements follow the vertex data and are not read
+    if (words[1] != "vertex")
+      fail_line("the first element is " + quote_token(words[1]) + ", expected 'vertex'");
+    const char* end = words[2].data() + words[2].size();
+    const auto [ptr, ec] = std::from_chars(words[2].data(), end, header_.vertex_count);
+    if (ec != std::errc() || ptr != end) fail_line("bad vertex count " + quote_token(words[2]));
+    vertex_seen_ = true;
+  }
+
+  void parse_property(const std::vector<std::string_view>& words) {
+    if (!vertex_seen_) fail_line("property before any element");
+    if (!in_vertex_) return;
+    if (words.size() >= 2 && words[1] == "list")
+      fail_line("list properties in the vertex element are not supported");
+    if (words.size() != 3) fail_line("expected 'property <type> <name>'");
+    const std::optional<Scalar> type = scalar_named(words[1]);
+    if (!type) fail_line("unknown property type " + quote_token(words[1]));
+    header_.properties.push_back({std::string(words[2]), *type});
+  }
+
+  std::string_view bytes_;
+  const fs::path& name_;
+  size_t pos_ = 0;
+  size_t line_number_ = 0;
+  Header header_;
+  bool format_seen_ = false, vertex_seen_ = false, in_vertex_ = false;
+};
+
+bool is_rest_coefficient(const Property& property) {
+  return std::string_view(property.name).substr(0, kRestPrefix.size()) == kRestPrefix;
+}
+
+int infer_sh_degree(const Header& header, const fs::path& name) {
+  const size_t rest =
+      std::count_if(header.properties.begin(), header.properties.end(), is_rest_coefficient);
+  for (int degree = 0; degree <= kMaxShDegree; ++degree)
+    if (rest == 3 * rest_per_channel(degree)) return degree;
+  fail_file(name,
+            fmt::format("{} f_rest properties; expected 0, 9, 24 or 45 (SH degree 0 to 3)", rest));
+}
+
+// The slot of each vertex property in file order (nullptr for properties not stored).
+std::vector<const Slot*> match_properties(const Header& header, const std::vector<Slot>& slots,
+                                          const fs::path& name) {
+  std::unordered_map<std::string_view, const Slot*> by_name;
+  for (const Slot& slot : slots) by_name[slot.name] = &slot;
+  std::unordered_set<std::string_view> seen;
+  std::vector<const Slot*> targets;
+  for (const Property& property : header.properties) {
+    if (!seen.insert(property.name).second)
+      fail_file(name, "duplicate property " + quote_token(property.name));
+    const auto it = by_name.find(property.name);
+    targets.push_back(it != by_name.end() && it->second->field ? it->second : nullptr);
+  }
+  for (const Slot& slot : slots)
+    if (slot.field && !seen.count(slot.name))
+      fail_file(name, "missing property " + quote_token(slot.name));
+  return targets;
+}
+
+// Rejects a vertex count the body cannot hold before anything is allocated for it. An ascii value
+// takes at least two bytes (a digit and a separator), the very last one at least one.
+void check_count_fits(const Header& header, size_t body_size, const fs::path& name) {
+  size_t per_vertex = 0;
+  for (const Property& property : header.properties)
+    per_vertex += header.ascii ? 2 : scalar_size(property.type);
+  const size_t room = header.ascii ? body_size + 1 : body_size;
+  if (header.vertex_count > room / per_vertex)
+    fail_file(name, fmt::format("{} vertices do not fit in the {} bytes after the header "
+                                "(truncated file or wrong count)",
+                                header.vertex_count, body_size));
+}
+
+SplatCloud allocate(const Header& header, const std::vector<Slot>& slots, int sh_degree) {
+  SplatCloud cloud;
+  cloud.sh_degree = sh_degree;
+  for (const Slot& slot : slots)
+    if (slot.field) (cloud.*slot.field).resize(header.vertex_count * slot.width);
+  return cloud;
+}
+
+// Values of an ascii body, whitespace-separated.
+class AsciiValues {
+ public:
+  AsciiValues(std::string_view body, const fs::path& name) : body_(body), name_(name) {}
+
+  double next(size_t vertex, const Property& property) {
+    const size_t start = body_.find_first_not_of(" \t\r\n", pos_);
+    if (start == std::string_view::npos)
+      fail_file(name_, fmt::format("truncated: the data ends at vertex {}", vertex));
+    pos_ = std::min(body_.find_first_of(" \t\r\n", start), body_.size());
+    const std::string_view token = body_.substr(start, pos_ - start);
+    double value = 0;
+    const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+    if (ec != std::errc() || ptr != token.data() + token.size())
+      fail_file(name_, fmt::format("vertex {}: property {} has a bad number {}", vertex,
+                                   quote_token(property.name), quote_token(token)));
+    return value;
+  }
+
+ private:
+  std::string_view body_;
+  const fs::path& name_;
+  size_t pos_ = 0;
+};
+
+// Values of a binary_little_endian body, whose size check_count_fits has checked.
+class BinaryValues {
+ public:
+  explicit BinaryValues(std::string_view body) : next_(body.data()) {}
+
+  double next(size_t, const Property& property) {
+    const double value = load_scalar(next_, property.type);
+    next_ += scalar_size(property.type);
+    return value;
+  }
+
+ private:
+  const char* next_;
+};
+
+template <typename Values>
+void read_body(Values values, const Header& header, const std::vector<const Slot*>& targets,
+               SplatCloud& cloud, const fs::path& name) {
+  for (size_t i = 0; i < header.vertex_count; ++i)
+    for (size_t p = 0; p < header.properties.size(); ++p) {
+      const double value = values.next(i, header.properties[p]);
+      const Slot* slot = targets[p];
+      if (!slot) continue;
+      if (!(std::fabs(value) <= FLT_MAX))
+        fail_file(name, fmt::format("vertex {}: property '{}' is not a finite float ({})", i,
+                                    slot->name, value));
+      (cloud.*slot->field)[i * slot->width + slot->offset] = float(value);
+    }
+}
+
+}  // namespace
+
+void write_ply(const fs::path& path, const SplatCloud& cloud) {
+  const std::vector<Slot> slots = checked_layout(cloud, path);
+  write_atomically(path, [&](const fs::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out << header_text(cloud.size(), slots);
+    write_body(out, cloud, slots, path);
+    out.close();
+    if (!out) fail_file(path, "write failed (disk full or not writable?)");
+  });
+}
+
+void write_ply_filter_baked(const fs::path& path, const SplatCloud& cloud) {
+  checked_layout(cloud, path);  // before baking indexes the arrays
+  write_ply(path, bake_filter_3d(cloud));
+}
+
+SplatCloud read_ply(const fs::path& path) {
+  return parse_ply(read_file(path), path);
+}
+
+SplatCloud parse_ply(std::string_view bytes, const fs::path& name) {
+  const Header header = HeaderParser(bytes, name).parse();
+  const int sh_degree = infer_sh_degree(header, name);
+  const bool has_filter = std::any_of(header.properties.begin(), header.properties.end(),
+                                      [](const Property& p) { return p.name == kFilterName; });
+  const std::vector<Slot> slots = layout(sh_degree, has_filter);
+  const std::vector<const Slot*> targets = match_properties(header, slots, name);
+  const std::string_view body = bytes.substr(header.body_offset);
+  check_count_fits(header, body.size(), name);
+  SplatCloud cloud = allocate(header, slots, sh_degree);
+  if (header.ascii)
+    read_body(AsciiValues(body, name), header, targets, cloud, name);
+  else
+    read_body(BinaryValues(body), header, targets, cloud, name);
+  return cloud;
+}
+
+}  // namespace iesrgs

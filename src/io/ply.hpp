@@ -1,0 +1,47 @@
+#pragma once
+// Gaussian splat scenes as standard 3DGS .ply files (one "vertex" element, one float property per
+// stored parameter), the layout that 3DGS, Mip-Splatting and every splat viewer read and write.
+#include <cstddef>
+#include <filesystem>
+#include <string_view>
+#include <vector>
+
+namespace iesrgs {
+
+// Gaussians in 3DGS's raw (pre-activation) storage form, structure of arrays, N Gaussians.
+struct SplatCloud {
+  int sh_degree = 0;              // 0..3; K = (sh_degree + 1)^2 coefficients per channel
+  std::vector<float> positions;   // (N, 3)
+  std::vector<float> sh_dc;       // (N, 3)
+  std::vector<float> sh_rest;     // (N, K - 1, 3): coefficient-major, like 3DGS's tensor
+  std::vector<float> opacity;     // (N), logit
+  std::vector<float> log_scales;  // (N, 3)
+  std::vector<float> rotations;   // (N, 4), quaternion w x y z, not necessarily normalized
+  std::vector<float> filter_3d;   // (N) Mip-Splatting 3D filter std, or empty when absent
+
+  size_t size() const { return positions.size() / 3; }
+  bool has_filter_3d() const { return !filter_3d.empty(); }
+};
+
+// binary_little_endian float32 in 3DGS's property order: x y z nx ny nz f_dc_0..2 f_rest_*
+// opacity scale_0..2 rot_0..3, then Mip-Splatting's filter_3D when present. Normals are written as
+// zeros and f_rest channel-major (all R coefficients, then G, then B), as 3DGS flattens its
+// transposed tensor. Written atomically; throws Error naming the file when the arrays disagree in
+// size or hold a non-finite value.
+void write_ply(const std::filesystem::path& path, const SplatCloud& cloud);
+
+// The same with the 3D filter folded into each Gaussian, as Mip-Splatting's "fused" export, so
+// that viewers without the filter render it correctly: scale sqrt(s^2 + f^2) and opacity
+// sigmoid(o) * sqrt(prod(s^2) / prod(s^2 + f^2)), stored as log and logit; no filter_3D property.
+// A cloud without the filter is written as write_ply writes it.
+void write_ply_filter_baked(const std::filesystem::path& path, const SplatCloud& cloud);
+
+// Reads ascii or binary_little_endian files with the properties in any order and any scalar type;
+// unknown properties and elements after the vertex element are skipped. The SH degree follows from
+// the number of f_rest properties. Throws Error naming the file for anything it cannot use.
+SplatCloud read_ply(const std::filesystem::path& path);
+
+// read_ply on bytes already in memory; `name` is only used in error messages.
+SplatCloud parse_ply(std::string_view bytes, const std::filesystem::path& name);
+
+}  // namespace iesrgs
