@@ -1,0 +1,45 @@
+// iesrgs synth: the built-in synthetic scene, written as a NeRF-Synthetic dataset.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "cli/commands.hpp"
+#include "synth/dataset_writer.hpp"
+
+namespace iesrgs::cli {
+
+void add_synth_command(CLI::App& app) {
+  auto* command = app.add_subcommand(
+      "synth",
+      "Render the built-in synthetic scene as a NeRF-Synthetic dataset: RGBA PNGs, "
+      "transforms_train/test.json and ground-truth depth (.npy)");
+  auto output = std::make_shared<std::string>();
+  auto options = std::make_shared<synth::SynthOptions>();
+  command->add_option("-o,--output", *output, "Directory to write the scene into")->required();
+  command->add_option("--size", options->size, "Image width and height in pixels")
+      ->capture_default_str();
+  command->add_option("--views", options->train_views, "Training views (upper hemisphere)")
+      ->capture_default_str();
+  command->add_option("--test-views", options->test_views, "Test views (a spiral between them)")
+      ->capture_default_str();
+  command->add_option("--seed", options->seed, "Picks layout, colours and patterns")
+      ->capture_default_str();
+  command->add_option("--samples", options->samples,
+                      "Antialiasing samples per pixel, a square number (default: 16 up to 256 "
+                      "px, 9 up to 512 px, 4 above)");
+  command->callback([output, options] {
+    const auto start = std::chrono::steady_clock::now();
+    synth::write_synth_dataset(*output, *options, [](int done, int total) {
+      fmt::print(stderr, "\rrendered {}/{} views", done, total);
+      if (done == total) fmt::print(stderr, "\n");
+    });
+    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+    fmt::print("wrote {} train and {} test views of {}x{} to {} in {:.1f} s\n",
+               options->train_views, options->test_views, options->size, options->size, *output,
+               elapsed.count());
+  });
+}
+
+}  // namespace iesrgs::cli

@@ -1,0 +1,104 @@
+#include "synth/dataset_writer.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/image.hpp"
+#include "io/npy.hpp"
+#include "synth/camera_path.hpp"
+#include "synth/renderer.hpp"
+
+namespace iesrgs::synth {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kMaxSize = 8192;
+constexpr int kMaxViews = 100000;
+constexpr int kMaxSamples = 1024;
+
+int checked_grid(int samples) {
+  const int grid = int(std::lround(std::sqrt(double(samples))));
+  if (samples < 1 || samples > kMaxSamples || grid * grid != samples)
+    fail("synthetic scene: samples per pixel must be a square number from 1 to {}, got {}",
+         kMaxSamples, samples);
+  return grid;
+}
+
+void check_options(const SynthOptions& options) {
+  if (options.size < 8 || options.size > kMaxSize)
+    fail("synthetic scene: size must be 8 to {} pixels, got {}", kMaxSize, options.size);
+  if (options.train_views < 1 || options.train_views > kMaxViews)
+    fail("synthetic scene: training views must be 1 to {}, got {}", kMaxViews, options.train_views);
+  if (options.test_views < 0 || options.test_views > kMaxViews)
+    fail("synthetic scene: test views must be 0 to {}, got {}", kMaxViews, options.test_views);
+}
+
+struct SplitViews {
+  const char* name;  // "train" or "test", the folder and the transforms file suffix
+  std::vector<CameraPose> poses;
+};
+
+class DatasetWriter {
+ public:
+  DatasetWriter(const fs::path& dir, const SynthOptions& options, const ViewProgress& progress)
+      : dir_(dir), scene_(make_synth_scene(options.seed)), progress_(progress) {
+    settings_.width = settings_.height = options.size;
+    settings_.grid =
+        checked_grid(options.samples ? options.samples : default_samples(options.size));
+    total_ = options.train_views + options.test_views;
+  }
+
+  void write(const SplitViews& split) {
+    nlohmann::json frames = nlohmann::json::array();
+    for (size_t i = 0; i < split.poses.size(); ++i) {
+      const std::string stem = std::string(split.name) + "/r_" + std::to_string(i);
+      write_view(split.poses[i], stem);
+      frames.push_back({{"file_path", "./" + stem}, {"transform_matrix", split.poses[i].matrix()}});
+    }
+    const nlohmann::json transforms{{"camera_angle_x", settings_.camera_angle_x},
+                                    {"frames", frames}};
+    write_file_atomically(dir_ / (std::string("transforms_") + split.name + ".json"),
+                          transforms.dump(4) + "\n");
+  }
+
+ private:
+  void write_view(const CameraPose& pose, const std::string& stem) {
+    const RenderedView view = render_view(scene_, pose, settings_);
+    write_png(dir_ / (stem + ".png"), view.rgba);
+    write_npy(dir_ / (stem + "_depth.npy"), view.depth,
+              {size_t(settings_.height), size_t(settings_.width)});
+    ++done_;
+    if (progress_) progress_(done_, total_);
+  }
+
+  fs::path dir_;
+  SynthScene scene_;
+  RenderSettings settings_;
+  const ViewProgress& progress_;
+  int done_ = 0, total_ = 0;
+};
+
+}  // namespace
+
+int default_samples(int size) {
+  if (size <= 256) return 16;
+  if (size <= 512) return 9;
+  return 4;
+}
+
+void write_synth_dataset(const fs::path& dir, const SynthOptions& options,
+                         const ViewProgress& progress) {
+  check_options(options);
+  DatasetWriter writer(dir, options, progress);
+  writer.write({"train", train_orbit(options.train_views, options.seed)});
+  writer.write({"test", test_orbit(options.test_views)});
+}
+
+}  // namespace iesrgs::synth

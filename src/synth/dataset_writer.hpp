@@ -1,0 +1,30 @@
+#pragma once
+// Writes the synthetic scene as a NeRF-Synthetic dataset: transforms_{train,test}.json, RGBA
+// PNGs <split>/r_<i>.png with a transparent background, and ground-truth depth
+// <split>/r_<i>_depth.npy (float32, height x width, 0 where nothing is hit).
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+
+namespace iesrgs::synth {
+
+struct SynthOptions {
+  int size = 800;  // width and height in pixels
+  int train_views = 100;
+  int test_views = 50;
+  uint64_t seed = 0;  // picks the layout, colours and patterns; equal seeds give equal files
+  int samples = 0;    // per pixel, a square number (1, 4, 9, ...); 0 = default_samples(size)
+};
+
+// Fewer samples per pixel as the images grow, so every size renders in similar time.
+int default_samples(int size);
+
+// Called after each written view with the number written so far and the total.
+using ViewProgress = std::function<void(int done, int total)>;
+
+// Throws Error for options out of range and for files that cannot be written. The JSON files
+// are written after their split's images, so a complete transforms file means complete views.
+void write_synth_dataset(const std::filesystem::path& dir, const SynthOptions& options,
+                         const ViewProgress& progress = {});
+
+}  // namespace iesrgs::synth
