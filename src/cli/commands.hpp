@@ -1,0 +1,10 @@
+#pragma once
+// Each subcommand lives in its own file and registers itself on the top-level app.
+#include <CLI/CLI.hpp>
+
+namespace iesrgs::cli {
+
+void add_synth_command(CLI::App& app);
+void add_info_command(CLI::App& app);
+
+}  // namespace iesrgs::cli

@@ -1,0 +1,75 @@
+// iesrgs info: what a scene holds, and with --load-images whether every image decodes.
+#include <fmt/format.h>
+
+#include <map>
+
+#include "cli/commands.hpp"
+#include "cli/scene_options.hpp"
+#include "io/view_images.hpp"
+
+namespace iesrgs::cli {
+
+namespace {
+
+void print_summary(const Scene& scene) {
+  fmt::print("scene       {}\n", scene.root.string());
+  fmt::print("format      {}\n", scene.format);
+  fmt::print("cameras     {} ({} train, {} test)\n", scene.cameras.size(),
+             scene.split(Split::Train).size(), scene.split(Split::Test).size());
+  std::map<std::pair<int, int>, int> sizes;
+  int distorted = 0;
+  for (const Camera& camera : scene.cameras) {
+    ++sizes[{camera.intrinsics.width, camera.intrinsics.height}];
+    distorted += camera.distortion.any();
+  }
+  for (const auto& [size, count] : sizes)
+    fmt::print("image size  {}x{} ({} cameras{})\n", size.first, size.second, count,
+               scene.downscale > 1 ? fmt::format(", downscaled by {}", scene.downscale) : "");
+  const Intrinsics& k = scene.cameras.front().intrinsics;
+  fmt::print("intrinsics  fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f} (fov {:.2f} x {:.2f} deg)\n",
+             k.fx, k.fy, k.cx, k.cy, k.fov_x() * 57.29577951308232, k.fov_y() * 57.29577951308232);
+  if (distorted)
+    fmt::print("distortion  {} cameras, undistorted to pinhole when loaded\n", distorted);
+  fmt::print("points      {}\n", scene.points.positions.size());
+  const SceneNormalization norm = scene.normalization();
+  fmt::print("extent      center ({:.3f}, {:.3f}, {:.3f}) radius {:.3f}\n", norm.center.x,
+             norm.center.y, norm.center.z, norm.radius);
+  fmt::print("background  {:.3g} {:.3g} {:.3g}\n", scene.background[0], scene.background[1],
+             scene.background[2]);
+}
+
+// Decodes every image in order and stops at the first bad one (the Error names it).
+void load_every_image(const Scene& scene) {
+  ViewImageOptions options;
+  options.cache_bytes = 0;  // stream: one image in memory at a time
+  ViewImages images(scene, options);
+  size_t done = 0;
+  for (const Camera& camera : scene.cameras) {
+    images.rgb(camera);
+    ++done;
+    if (done % 25 == 0 || done == scene.cameras.size())
+      fmt::print(stderr, "\rdecoded {}/{} images", done, scene.cameras.size());
+  }
+  fmt::print(stderr, "\n");
+  fmt::print("images      all {} decoded\n", done);
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app) {
+  auto* command =
+      app.add_subcommand("info", "Print a scene's cameras, image size, splits, points and extent");
+  auto args = std::make_shared<SceneArgs>();
+  auto load_images = std::make_shared<bool>(false);
+  args->add_to(*command);
+  command->add_flag("--load-images", *load_images,
+                    "Also decode every image (undistorted and resized as training would) and "
+                    "fail on the first bad one");
+  command->callback([args, load_images] {
+    const Scene scene = load_scene(args->path, args->resolved());
+    print_summary(scene);
+    if (*load_images) load_every_image(scene);
+  });
+}
+
+}  // namespace iesrgs::cli

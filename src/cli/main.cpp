@@ -1,0 +1,33 @@
+// iesrgs: low-resolution multi-view captures in, high-resolution 3D Gaussian Splatting out.
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <exception>
+
+#include "cli/commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"iesrgs: super-resolution 3D Gaussian Splatting (IE-SRGS) on CPUs and GPUs"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "iesrgs 0.1.0");
+  app.add_flag_callback(
+      "-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); }, "Print debug messages");
+  iesrgs::cli::add_synth_command(app);
+  iesrgs::cli::add_info_command(app);
+  // Whatever was printed before an error comes first, so the error is the last line.
+  const auto report = [](const char* message) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "error: %s\n", message);
+    return 1;
+  };
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::bad_alloc&) {
+    return report("out of memory");
+  } catch (const std::exception& e) {
+    return report(e.what());
+  }
+  return 0;
+}

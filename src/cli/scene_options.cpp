@@ -1,0 +1,47 @@
+#include "cli/scene_options.hpp"
+
+#include "core/error.hpp"
+
+namespace iesrgs::cli {
+
+void SceneArgs::add_to(CLI::App& command) {
+  command
+      .add_option("scene", path,
+                  "Scene: a folder with transforms_train.json (NeRF Synthetic), "
+                  "transforms.json (nerfstudio / instant-ngp) or sparse/0 (COLMAP), "
+                  "or a transforms.json file")
+      ->required();
+  command
+      .add_option("--downscale", options.downscale,
+                  "Load images at 1/k resolution: <images>_<k>/ when present, else a "
+                  "PIL-compatible bicubic resize")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command
+      .add_option("--background", background,
+                  "Background for RGBA images: white, black, or r,g,b in [0,1]")
+      ->capture_default_str();
+  command
+      .add_option("--test-every", options.test_every,
+                  "Hold out every k-th image for test when the format has no test split")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
+SceneOptions SceneArgs::resolved() const {
+  SceneOptions resolved = options;
+  if (background == "white") {
+    resolved.background = {1, 1, 1};
+  } else if (background == "black") {
+    resolved.background = {0, 0, 0};
+  } else {
+    float r, g, b;
+    char tail;
+    if (std::sscanf(background.c_str(), "%f,%f,%f%c", &r, &g, &b, &tail) != 3)
+      fail("--background: expected white, black or r,g,b, got '{}'", background);
+    resolved.background = {r, g, b};
+  }
+  return resolved;
+}
+
+}  // namespace iesrgs::cli
