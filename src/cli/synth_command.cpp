@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -29,6 +30,14 @@ void add_synth_command(CLI::App& app) {
   command->add_option("--samples", options->samples,
                       "Antialiasing samples per pixel, a square number (default: 16 up to 256 "
                       "px, 9 up to 512 px, 4 above)");
+  const std::map<std::string, synth::SynthFormat> formats{{"blender", synth::SynthFormat::Blender},
+                                                          {"colmap", synth::SynthFormat::Colmap}};
+  command
+      ->add_option("--format", options->format,
+                   "blender: NeRF-Synthetic layout with separate test views; colmap: images/ "
+                   "and sparse/0 with surface points as SfM points, every 8th image held out")
+      ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case))
+      ->capture_default_str();
   command->callback([output, options] {
     const auto start = std::chrono::steady_clock::now();
     synth::write_synth_dataset(*output, *options, [](int done, int total) {
@@ -36,9 +45,13 @@ void add_synth_command(CLI::App& app) {
       if (done == total) fmt::print(stderr, "\n");
     });
     const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
-    fmt::print("wrote {} train and {} test views of {}x{} to {} in {:.1f} s\n",
-               options->train_views, options->test_views, options->size, options->size, *output,
-               elapsed.count());
+    const std::string views =
+        options->format == synth::SynthFormat::Colmap
+            ? fmt::format("{} views (every 8th is held out for test)",
+                          options->train_views + options->test_views)
+            : fmt::format("{} train and {} test views", options->train_views, options->test_views);
+    fmt::print("wrote {} of {}x{} to {} in {:.1f} s\n", views, options->size, options->size,
+               *output, elapsed.count());
   });
 }
 

@@ -1,5 +1,6 @@
 #include "synth/dataset_writer.hpp"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -11,6 +12,7 @@
 #include "io/image.hpp"
 #include "io/npy.hpp"
 #include "synth/camera_path.hpp"
+#include "synth/colmap_export.hpp"
 #include "synth/renderer.hpp"
 
 namespace iesrgs::synth {
@@ -22,6 +24,7 @@ namespace {
 constexpr int kMaxSize = 8192;
 constexpr int kMaxViews = 100000;
 constexpr int kMaxSamples = 1024;
+constexpr int kPointsPerView = 400;  // stand-in SfM points: 100 views give 40k points
 
 int checked_grid(int samples) {
   const int grid = int(std::lround(std::sqrt(double(samples))));
@@ -68,14 +71,33 @@ class DatasetWriter {
                           transforms.dump(4) + "\n");
   }
 
+  // Opaque photos over white, as a camera would take them; the model is written last, so a
+  // complete sparse/0 means complete images.
+  void write_colmap(const std::vector<CameraPose>& poses) {
+    ColmapExport colmap(settings_, kPointsPerView);
+    const float white[3] = {1, 1, 1};
+    for (size_t i = 0; i < poses.size(); ++i) {
+      const std::string stem = fmt::format("r_{:04d}", i);
+      const RenderedView view = render(poses[i], dir_ / "depth" / (stem + ".npy"));
+      write_png(dir_ / "images" / (stem + ".png"), composite_rgb(to_8bit(view.rgba), white));
+      colmap.add_view(poses[i], view, stem + ".png");
+    }
+    colmap.write(dir_);
+  }
+
  private:
-  void write_view(const CameraPose& pose, const std::string& stem) {
-    const RenderedView view = render_view(scene_, pose, settings_);
-    write_png(dir_ / (stem + ".png"), view.rgba);
-    write_npy(dir_ / (stem + "_depth.npy"), view.depth,
-              {size_t(settings_.height), size_t(settings_.width)});
+  // Renders one view, writes its depth to `depth_path` and reports progress.
+  RenderedView render(const CameraPose& pose, const fs::path& depth_path) {
+    RenderedView view = render_view(scene_, pose, settings_);
+    write_npy(depth_path, view.depth, {size_t(settings_.height), size_t(settings_.width)});
     ++done_;
     if (progress_) progress_(done_, total_);
+    return view;
+  }
+
+  void write_view(const CameraPose& pose, const std::string& stem) {
+    const RenderedView view = render(pose, dir_ / (stem + "_depth.npy"));
+    write_png(dir_ / (stem + ".png"), view.rgba);
   }
 
   fs::path dir_;
@@ -97,6 +119,10 @@ void write_synth_dataset(const fs::path& dir, const SynthOptions& options,
                          const ViewProgress& progress) {
   check_options(options);
   DatasetWriter writer(dir, options, progress);
+  if (options.format == SynthFormat::Colmap) {
+    writer.write_colmap(train_orbit(options.train_views + options.test_views, options.seed));
+    return;
+  }
   writer.write({"train", train_orbit(options.train_views, options.seed)});
   writer.write({"test", test_orbit(options.test_views)});
 }

@@ -1,14 +1,22 @@
 #pragma once
-// Writes the synthetic scene as a NeRF-Synthetic dataset: transforms_{train,test}.json, RGBA
-// PNGs <split>/r_<i>.png with a transparent background, and ground-truth depth
-// <split>/r_<i>_depth.npy (float32, height x width, 0 where nothing is hit).
+// Writes the synthetic scene as a dataset, in one of two layouts:
+// - NeRF Synthetic: transforms_{train,test}.json, RGBA PNGs <split>/r_<i>.png with a transparent
+//   background, and ground-truth depth <split>/r_<i>_depth.npy (float32, height x width, 0 where
+//   nothing is hit);
+// - COLMAP: one capture of train + test views over the upper hemisphere as opaque photos
+//   images/r_<iiii>.png (white background) with depth beside them, and sparse/0 holding the
+//   cameras, poses and surface points standing in for SfM points. The reader's every-8th-image
+//   hold-out makes its test split.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
 
 namespace iesrgs::synth {
 
+enum class SynthFormat { Blender, Colmap };
+
 struct SynthOptions {
+  SynthFormat format = SynthFormat::Blender;
   int size = 800;  // width and height in pixels
   int train_views = 100;
   int test_views = 50;

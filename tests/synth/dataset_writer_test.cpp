@@ -11,6 +11,8 @@
 #include "io/npy.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
+#include "io/colmap.hpp"
+#include "io/scene.hpp"
 #include "synth/dataset_writer.hpp"
 #include "synth/renderer.hpp"
 
@@ -172,6 +174,44 @@ TEST(SynthDataset, UnwritableDirectoryIsAnErrorNamingIt) {
   testing::write_text(dir / "file", "not a directory");
   const std::string message = error_message([&] { write_synth_dataset(dir / "file", tiny()); });
   EXPECT_NE(message.find((dir / "file").string()), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace iesrgs::synth
+
+namespace iesrgs::synth {
+namespace {
+
+TEST(SynthColmap, LoadsAsAColmapSceneWhosePointsProjectOntoTheirObservations) {
+  TempDir dir;
+  SynthOptions options = tiny();
+  options.format = SynthFormat::Colmap;
+  options.train_views = 7;
+  options.test_views = 2;
+  write_synth_dataset(dir.path(), options);
+  const Scene scene = load_scene(dir.path());
+  EXPECT_EQ(scene.format, "colmap");
+  ASSERT_EQ(scene.cameras.size(), 9u);
+  EXPECT_EQ(scene.split(Split::Test).size(), 2u);  // r_0000 and r_0008
+  ASSERT_GT(scene.points.positions.size(), 50u);
+
+  const ColmapModel model = read_colmap_model(dir / "sparse" / "0");
+  for (const ColmapPoint& point : model.points) {
+    ASSERT_EQ(point.track.size(), 1u);
+    const ColmapImage& image = model.images.at(point.track[0].image_id);
+    const Camera& camera = scene.cameras[image.id - 1];  // names sort in writing order
+    ASSERT_EQ(camera.name + ".png", image.name);
+    const Vec3 p = camera.rotation * Vec3{point.x, point.y, point.z} + camera.translation;
+    const ColmapObservation& seen = image.observations[point.track[0].point2d_index];
+    const Intrinsics& k = camera.intrinsics;
+    EXPECT_NEAR(k.fx * p.x / p.z + k.cx, seen.x, 1e-3);
+    EXPECT_NEAR(k.fy * p.y / p.z + k.cy, seen.y, 1e-3);
+    // The point's colour is the photo's pixel there (fully covered pixels only).
+    const Image8 photo = read_image8(camera.image_path);
+    const int x = int(seen.x), y = int(seen.y);
+    EXPECT_NEAR(photo.at(x, y, 0), point.r, 1);
+    EXPECT_NEAR(photo.at(x, y, 2), point.b, 1);
+  }
 }
 
 }  // namespace
