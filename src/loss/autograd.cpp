@@ -1,0 +1,129 @@
+#include "loss/autograd.hpp"
+
+#include <cstdint>
+#include <limits>
+
+#include <ATen/ATen.h>
+#include <torch/csrc/autograd/custom_function.h>
+
+#include "core/error.hpp"
+#include "loss/pearson.hpp"
+#include "loss/ssim.hpp"
+
+namespace iesrgs::loss {
+namespace {
+
+using torch::autograd::AutogradContext;
+using torch::autograd::variable_list;
+
+// Calls body(T{}) with T the tensor's scalar type, float or double.
+template <typename Body>
+auto with_scalar_type(const at::Tensor& tensor, Body&& body) {
+  return tensor.scalar_type() == at::kDouble ? body(double{}) : body(float{});
+}
+
+void check_pair(const char* what, const at::Tensor& value, const at::Tensor& target) {
+  if (!value.defined() || !target.defined()) fail("{}: undefined tensor", what);
+  if (value.device().type() != at::kCPU || target.device().type() != at::kCPU)
+    fail("{}: tensors must be on the CPU", what);
+  if (value.scalar_type() != at::kFloat && value.scalar_type() != at::kDouble)
+    fail("{}: dtype {} is not float32 or float64", what, c10::toString(value.scalar_type()));
+  if (target.scalar_type() != value.scalar_type())
+    fail("{}: target dtype {} differs from {}", what, c10::toString(target.scalar_type()),
+         c10::toString(value.scalar_type()));
+  if (target.sizes() != value.sizes())
+    fail("{}: target shape {} differs from {}", what, c10::str(target.sizes()),
+         c10::str(value.sizes()));
+  if (target.requires_grad()) fail("{}: the target must not require grad", what);
+}
+
+ImageShape chw_shape(const at::Tensor& image) {
+  constexpr int64_t kMaxSide = std::numeric_limits<int>::max();
+  if (image.dim() != 3 || image.size(0) > kMaxSide || image.size(1) > kMaxSide ||
+      image.size(2) > kMaxSide)
+    fail("ssim: image shape {} is not (C, H, W)", c10::str(image.sizes()));
+  const ImageShape shape{int(image.size(2)), int(image.size(1)), int(image.size(0))};
+  check_shape(shape, "ssim");
+  return shape;
+}
+
+class SsimFunction : public torch::autograd::Function<SsimFunction> {
+ public:
+  static variable_list forward(AutogradContext* ctx, const at::Tensor& x_in,
+                               const at::Tensor& y_in) {
+    const at::Tensor x = x_in.contiguous(), y = y_in.contiguous();
+    const ImageShape shape = chw_shape(x);
+    at::Tensor map = at::empty({shape.height, shape.width}, x.options());
+    at::Tensor partials = at::empty({int64_t(ssim_partials_size(shape))}, x.options());
+    const double mean = with_scalar_type(x, [&](auto zero) {
+      using T = decltype(zero);
+      return ssim<T>(x.data_ptr<T>(), y.data_ptr<T>(), shape, map.data_ptr<T>(),
+                     partials.data_ptr<T>());
+    });
+    ctx->save_for_backward({x, y, partials});
+    return {at::scalar_tensor(mean, x.options()), map};
+  }
+
+  // Upstream gradients arrive materialized (zeros for an unused output).
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const variable_list saved = ctx->get_saved_variables();
+    const at::Tensor &x = saved[0], &y = saved[1], &partials = saved[2];
+    const ImageShape shape = chw_shape(x);
+    // d mean / d map[p] = 1 / pixels.
+    const at::Tensor weight = (grads[1] + grads[0] / double(shape.pixels())).contiguous();
+    at::Tensor grad_x = at::zeros_like(x);
+    with_scalar_type(x, [&](auto zero) {
+      using T = decltype(zero);
+      ssim_backward<T>(x.data_ptr<T>(), y.data_ptr<T>(), shape, partials.data_ptr<T>(),
+                       weight.data_ptr<T>(), grad_x.data_ptr<T>());
+    });
+    return {grad_x, at::Tensor()};
+  }
+};
+
+class PearsonFunction : public torch::autograd::Function<PearsonFunction> {
+ public:
+  static at::Tensor forward(AutogradContext* ctx, const at::Tensor& a_in, const at::Tensor& b_in,
+                            const at::Tensor& mask_in) {
+    const at::Tensor a = a_in.contiguous(), b = b_in.contiguous();
+    const at::Tensor mask = mask_in.to(at::kByte).contiguous();
+    const double correlation = with_scalar_type(a, [&](auto zero) {
+      using T = decltype(zero);
+      return pearson_correlation<T>(a.data_ptr<T>(), b.data_ptr<T>(), mask.data_ptr<uint8_t>(),
+                                    a.numel());
+    });
+    ctx->save_for_backward({a, b, mask});
+    return at::scalar_tensor(correlation, a.options());
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const variable_list saved = ctx->get_saved_variables();
+    const at::Tensor &a = saved[0], &b = saved[1], &mask = saved[2];
+    at::Tensor grad_a = at::zeros_like(a);
+    with_scalar_type(a, [&](auto zero) {
+      using T = decltype(zero);
+      pearson_correlation_backward<T>(a.data_ptr<T>(), b.data_ptr<T>(), mask.data_ptr<uint8_t>(),
+                                      a.numel(), grads[0].item<double>(), grad_a.data_ptr<T>());
+    });
+    return {grad_a, at::Tensor(), at::Tensor()};
+  }
+};
+
+}  // namespace
+
+SsimTensors ssim_autograd(const at::Tensor& x, const at::Tensor& y) {
+  check_pair("ssim", x, y);
+  const variable_list out = SsimFunction::apply(x, y);
+  return {out[0], out[1]};
+}
+
+at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
+  check_pair("pearson", a, b);
+  if (mask.defined() && (mask.sizes() != a.sizes() || mask.device().type() != at::kCPU))
+    fail("pearson: mask must be a CPU tensor of shape {}, not {} on {}", c10::str(a.sizes()),
+         c10::str(mask.sizes()), c10::str(mask.device()));
+  // autograd::Function takes defined tensors only.
+  return PearsonFunction::apply(a, b, mask.defined() ? mask : at::ones(a.sizes(), at::kByte));
+}
+
+}  // namespace iesrgs::loss

@@ -1,0 +1,178 @@
+#include "loss/autograd.hpp"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <utility>
+#include <vector>
+
+#include "loss/ssim.hpp"
+#include "support/expect_error.hpp"
+
+namespace iesrgs::loss {
+namespace {
+
+// SSIM of (C, H, W) images written with torch ops, as 3DGS writes it (grouped conv2d with the
+// 11x11 Gaussian window, padding 5): returns the scalar and the channel-averaged map.
+std::pair<at::Tensor, at::Tensor> torch_ops_ssim(const at::Tensor& x, const at::Tensor& y) {
+  const int64_t channels = x.size(0);
+  at::Tensor gauss = torch::exp(-(torch::arange(11, x.options()) - 5).pow(2) / 4.5);
+  gauss = gauss / gauss.sum();
+  const at::Tensor window = torch::outer(gauss, gauss).expand({channels, 1, 11, 11}).contiguous();
+  const auto conv = [&](const at::Tensor& t) {
+    return torch::conv2d(t, window, {}, /*stride=*/1, /*padding=*/5, /*dilation=*/1, channels);
+  };
+  const at::Tensor a = x.unsqueeze(0), b = y.unsqueeze(0);
+  const at::Tensor mu1 = conv(a), mu2 = conv(b);
+  const at::Tensor var1 = conv(a * a) - mu1 * mu1, var2 = conv(b * b) - mu2 * mu2;
+  const at::Tensor cov = conv(a * b) - mu1 * mu2;
+  const double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;
+  const at::Tensor map =
+      (2 * mu1 * mu2 + c1) * (2 * cov + c2) / ((mu1 * mu1 + mu2 * mu2 + c1) * (var1 + var2 + c2));
+  return {map.mean(), map.mean(1)[0]};
+}
+
+at::Tensor torch_ops_pearson(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
+  const at::Tensor da = a.masked_select(mask) - a.masked_select(mask).mean();
+  const at::Tensor db = b.masked_select(mask) - b.masked_select(mask).mean();
+  return (da * db).sum() / torch::sqrt((da * da).sum() * (db * db).sum());
+}
+
+struct Images {
+  at::Tensor x, y, weight;  // weight: (H, W) upstream gradient of the map
+};
+
+Images random_images(at::ScalarType dtype) {
+  torch::manual_seed(1);
+  const auto options = torch::TensorOptions().dtype(dtype);
+  Images images{torch::rand({3, 23, 31}, options), torch::rand({3, 23, 31}, options),
+                torch::randn({23, 31}, options)};
+  // A flat block, where the window variances vanish.
+  images.x.slice(1, 0, 12).slice(2, 0, 12).fill_(0.9);
+  images.y.slice(1, 0, 12).slice(2, 0, 12).fill_(0.4);
+  return images;
+}
+
+// d/dx of 0.3 * mean + sum(weight * map), both outputs used.
+template <typename Ssim>
+at::Tensor composed_gradient(const Images& images, Ssim&& ssim_fn) {
+  const at::Tensor x = images.x.detach().clone().requires_grad_(true);
+  const auto [mean, map] = ssim_fn(x, images.y);
+  (0.3 * mean + (map * images.weight).sum()).backward();
+  return x.grad();
+}
+
+double max_difference(const at::Tensor& a, const at::Tensor& b) {
+  return (a.to(at::kDouble) - b.to(at::kDouble)).abs().max().item<double>();
+}
+
+std::pair<at::Tensor, at::Tensor> kernel_ssim(const at::Tensor& x, const at::Tensor& y) {
+  const SsimTensors out = ssim_autograd(x, y);
+  return {out.mean, out.map};
+}
+
+TEST(SsimAutograd, MatchesTorchOpsInDouble) {
+  const Images images = random_images(at::kDouble);
+  const auto [mean, map] = kernel_ssim(images.x, images.y);
+  const auto [expected_mean, expected_map] = torch_ops_ssim(images.x, images.y);
+  EXPECT_LT(max_difference(mean, expected_mean), 1e-12);
+  EXPECT_LT(max_difference(map, expected_map), 1e-12);
+  EXPECT_LT(max_difference(composed_gradient(images, kernel_ssim),
+                           composed_gradient(images, torch_ops_ssim)),
+            1e-10);
+}
+
+TEST(SsimAutograd, FloatMatchesTorchOpsInDouble) {
+  const Images images = random_images(at::kFloat);
+  const Images in_double{images.x.to(at::kDouble), images.y.to(at::kDouble),
+                         images.weight.to(at::kDouble)};
+  const auto [mean, map] = kernel_ssim(images.x, images.y);
+  EXPECT_EQ(map.scalar_type(), at::kFloat);
+  const auto [expected_mean, expected_map] = torch_ops_ssim(in_double.x, in_double.y);
+  EXPECT_LT(max_difference(mean, expected_mean), 1e-6);
+  EXPECT_LT(max_difference(map, expected_map), 1e-5);
+  // In float, the flat block's gradient is the difference of terms ~1/C2 times larger: the
+  // kernel may not lose more there than torch's own float autograd does.
+  const at::Tensor expected = composed_gradient(in_double, torch_ops_ssim);
+  const double error = max_difference(composed_gradient(images, kernel_ssim), expected);
+  EXPECT_LT(error, 1e-4 * expected.abs().max().item<double>());
+  EXPECT_LE(error, max_difference(composed_gradient(images, torch_ops_ssim), expected));
+}
+
+TEST(SsimAutograd, GradientIsTheRawBackward) {
+  const Images images = random_images(at::kFloat);
+  const ImageShape shape{31, 23, 3};
+  const at::Tensor weight = (images.weight + 0.3 / double(shape.pixels())).contiguous();
+  std::vector<float> partials(ssim_partials_size(shape));
+  at::Tensor expected = torch::zeros_like(images.x);
+  ssim<float>(images.x.data_ptr<float>(), images.y.data_ptr<float>(), shape, nullptr,
+              partials.data());
+  ssim_backward<float>(images.x.data_ptr<float>(), images.y.data_ptr<float>(), shape,
+                       partials.data(), weight.data_ptr<float>(), expected.data_ptr<float>());
+  EXPECT_LT(max_difference(composed_gradient(images, kernel_ssim), expected), 1e-7);
+}
+
+TEST(SsimAutograd, MeanAloneAndNonContiguousInput) {
+  const Images images = random_images(at::kDouble);
+  const at::Tensor x_hwc = images.x.permute({1, 2, 0}).contiguous().requires_grad_(true);
+  const at::Tensor x = x_hwc.permute({2, 0, 1});  // (C, H, W) view, not contiguous
+  ssim_autograd(x, images.y).mean.backward();
+  const at::Tensor reference = images.x.detach().clone().requires_grad_(true);
+  torch_ops_ssim(reference, images.y).first.backward();
+  EXPECT_LT(max_difference(x_hwc.grad().permute({2, 0, 1}), reference.grad()), 1e-12);
+}
+
+TEST(SsimAutograd, BadInputsAreErrors) {
+  const at::Tensor image = torch::rand({3, 8, 9});
+  EXPECT_EQ(testing::error_message([&] {
+              ssim_autograd(image, torch::rand({1, 8, 9}));
+            }),
+            "ssim: target shape [1, 8, 9] differs from [3, 8, 9]");
+  EXPECT_EQ(testing::error_message([&] { ssim_autograd(image[0], image[0]); }),
+            "ssim: image shape [8, 9] is not (C, H, W)");
+  EXPECT_EQ(
+      testing::error_message([&] { ssim_autograd(image, image.clone().requires_grad_(true)); }),
+      "ssim: the target must not require grad");
+  EXPECT_EQ(testing::error_message([&] { ssim_autograd(image, image.to(at::kDouble)); }),
+            "ssim: target dtype Double differs from Float");
+  EXPECT_EQ(testing::error_message([&] { ssim_autograd(image.to(at::kInt), image.to(at::kInt)); }),
+            "ssim: dtype Int is not float32 or float64");
+}
+
+TEST(PearsonAutograd, MatchesTorchOpsWithAndWithoutMask) {
+  torch::manual_seed(2);
+  const auto options = torch::TensorOptions().dtype(at::kDouble);
+  const at::Tensor a = torch::rand({17, 19}, options), b = torch::rand({17, 19}, options) + a;
+  const at::Tensor mask = torch::rand({17, 19}) > 0.3;
+  for (const at::Tensor& m : {mask, torch::ones({17, 19}, torch::kBool)}) {
+    const at::Tensor x = a.clone().requires_grad_(true), ref = a.clone().requires_grad_(true);
+    const at::Tensor loss = 1 - pearson_autograd(x, b, m.all().item<bool>() ? at::Tensor() : m);
+    const at::Tensor expected = 1 - torch_ops_pearson(ref, b, m);
+    EXPECT_LT(max_difference(loss, expected), 1e-12);
+    loss.backward();
+    expected.backward();
+    EXPECT_LT(max_difference(x.grad(), ref.grad()), 1e-12);
+  }
+}
+
+TEST(PearsonAutograd, FloatMatchesTorchOpsInDouble) {
+  torch::manual_seed(3);
+  const at::Tensor a = torch::rand({40, 30}) + 5, b = torch::rand({40, 30}) - a;
+  const at::Tensor mask = torch::rand({40, 30}) > 0.5;
+  const at::Tensor x = a.clone().requires_grad_(true);
+  const at::Tensor ref = a.to(at::kDouble).requires_grad_(true);
+  pearson_autograd(x, b, mask).backward();
+  torch_ops_pearson(ref, b.to(at::kDouble), mask).backward();
+  EXPECT_LT(max_difference(x.grad(), ref.grad()), 1e-5);
+}
+
+TEST(PearsonAutograd, MaskOfAnotherShapeIsAnError) {
+  const at::Tensor a = torch::rand({4, 5});
+  EXPECT_EQ(testing::error_message([&] {
+              pearson_autograd(a, a, torch::ones({5, 4}) > 0);
+            }),
+            "pearson: mask must be a CPU tensor of shape [4, 5], not [5, 4] on cpu");
+}
+
+}  // namespace
+}  // namespace iesrgs::loss
