@@ -6,28 +6,21 @@
 
 namespace iesrgs {
 
-// Interleaved channels, row-major, values in [0, 1] for color.
-struct Image {
+// Interleaved channels (HWC), row-major.
+template <typename T>
+struct ImageOf {
   int width = 0, height = 0, channels = 0;
-  std::vector<float> data;
+  std::vector<T> data;
 
-  Image() = default;
-  Image(int w, int h, int c) : width(w), height(h), channels(c), data(size_t(w) * h * c, 0.f) {}
-  float& at(int x, int y, int c) { return data[(size_t(y) * width + x) * channels + c]; }
-  float at(int x, int y, int c) const { return data[(size_t(y) * width + x) * channels + c]; }
+  ImageOf() = default;
+  ImageOf(int w, int h, int c) : width(w), height(h), channels(c), data(size_t(w) * h * c, T{}) {}
+  T& at(int x, int y, int c) { return data[(size_t(y) * width + x) * channels + c]; }
+  T at(int x, int y, int c) const { return data[(size_t(y) * width + x) * channels + c]; }
   size_t pixels() const { return size_t(width) * height; }
 };
 
-// 8-bit image as stored in files.
-struct Image8 {
-  int width = 0, height = 0, channels = 0;
-  std::vector<uint8_t> data;
-
-  Image8() = default;
-  Image8(int w, int h, int c) : width(w), height(h), channels(c), data(size_t(w) * h * c, 0) {}
-  uint8_t& at(int x, int y, int c) { return data[(size_t(y) * width + x) * channels + c]; }
-  uint8_t at(int x, int y, int c) const { return data[(size_t(y) * width + x) * channels + c]; }
-};
+using Image = ImageOf<float>;     // values in [0, 1] for color
+using Image8 = ImageOf<uint8_t>;  // as stored in files
 
 struct ImageHeader {
   int width = 0, height = 0, channels = 0;
