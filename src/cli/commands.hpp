@@ -6,5 +6,6 @@ namespace iesrgs::cli {
 
 void add_synth_command(CLI::App& app);
 void add_info_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 }  // namespace iesrgs::cli

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
       "-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); }, "Print debug messages");
   iesrgs::cli::add_synth_command(app);
   iesrgs::cli::add_info_command(app);
+  iesrgs::cli::add_bench_command(app);
   // Whatever was printed before an error comes first, so the error is the last line.
   const auto report = [](const char* message) {
     std::fflush(stdout);

@@ -1,0 +1,68 @@
+#pragma once
+// Mip-Splatting's two low-pass filters, as opacity-preserving convolutions of the Gaussian.
+// 3D smoothing filter: the world-space covariance gets filter_std^2 on its diagonal (in the
+// Gaussian's own frame, i.e. on every scale) and the opacity is scaled so that the integral is
+// unchanged. 2D mip filter: the screen-space covariance gets kMipFilterVariance on its diagonal
+// and the opacity the matching factor.
+#include "raster/geometry.hpp"
+
+namespace iesrgs::gs {
+
+// Variance in pixels^2 of the screen-space box-filter approximation (3DGS dilates by 0.3).
+constexpr double kMipFilterVariance = 0.1;
+// Floor on det(cov) / det(cov + filter), as Mip-Splatting, for numerical stability.
+constexpr double kMinMipDetRatio = 0.000025;
+
+// scale: activated scales; var: effective variances s^2 + f^2; returns the opacity factor
+// sqrt(prod(s^2) / prod(s^2 + f^2)).
+template <typename T>
+IESRGS_HD T filter3d(const T* scale, T filter_std, T* var) {
+  const T f2 = filter_std * filter_std;
+  T ratio = 1;
+  for (int k = 0; k < 3; ++k) {
+    const T s2 = scale[k] * scale[k];
+    var[k] = s2 + f2;
+    ratio *= s2 / var[k];
+  }
+  return hd::sqrt(ratio);
+}
+
+// dscale = dL/dscale from dL/dvar and dL/dfactor.
+template <typename T>
+IESRGS_HD void filter3d_backward(const T* scale, T filter_std, const T* dvar, T dfactor,
+                                 T* dscale) {
+  T var[3];
+  const T factor = filter3d(scale, filter_std, var);
+  const T f2 = filter_std * filter_std;
+  // d log(factor) / d s_k = f^2 / (s_k (s_k^2 + f^2))
+  for (int k = 0; k < 3; ++k)
+    dscale[k] = T(2) * scale[k] * dvar[k] + dfactor * factor * f2 / (scale[k] * var[k]);
+}
+
+// Returns the opacity factor and writes the filtered covariance.
+template <typename T>
+IESRGS_HD T filter2d(const raster::Sym2<T>& cov, raster::Sym2<T>& filtered) {
+  const T h = T(kMipFilterVariance);
+  filtered = {cov.xx + h, cov.xy, cov.yy + h};
+  return hd::sqrt(hd::max(T(kMinMipDetRatio), raster::det(cov) / raster::det(filtered)));
+}
+
+// dL/dcov from dL/dfiltered and dL/dfactor (no factor gradient where the floor is active).
+template <typename T>
+IESRGS_HD raster::Sym2<T> filter2d_backward(const raster::Sym2<T>& cov,
+                                            const raster::Sym2<T>& dfiltered, T dfactor) {
+  raster::Sym2<T> filtered;
+  const T factor = filter2d(cov, filtered);
+  const T det0 = raster::det(cov), det1 = raster::det(filtered);
+  raster::Sym2<T> dcov = dfiltered;
+  if (det0 / det1 <= T(kMinMipDetRatio)) return dcov;
+  // factor = sqrt(det0 / det1); d det / d(xx, xy, yy) = (yy, -2 xy, xx)
+  const T g = dfactor / (T(2) * factor * det1);
+  const T r = det0 / det1;
+  dcov.xx += g * (cov.yy - r * filtered.yy);
+  dcov.xy += g * T(-2) * (cov.xy - r * filtered.xy);
+  dcov.yy += g * (cov.xx - r * filtered.xx);
+  return dcov;
+}
+
+}  // namespace iesrgs::gs

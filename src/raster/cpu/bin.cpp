@@ -1,0 +1,107 @@
+// Tile binning: a counting sort of splat-tile entries by tile, then a depth sort inside each tile.
+// Per-tile sorts are small and independent, so they run in parallel and stay in cache, unlike
+// one global sort by a (tile, depth) key; the order is the same.
+#include <algorithm>
+#include <cstring>
+
+#include "core/error.hpp"
+#include "raster/cpu/kernels.hpp"
+
+namespace iesrgs::raster::cpu {
+
+namespace {
+
+struct TileRect {
+  int x0, y0, x1, y1;
+};
+
+TileRect tiles_of(const PixelRect& r) {
+  if (r.empty()) return {0, 0, 0, 0};
+  return {r.x0 / kTileSize, r.y0 / kTileSize, (r.x1 - 1) / kTileSize + 1,
+          (r.y1 - 1) / kTileSize + 1};
+}
+
+// Camera z is above the near plane, hence positive: the IEEE bits of a positive float sort like
+// its value. Ties are broken by the slot, i.e. by Gaussian index.
+template <typename T>
+uint32_t depth_bits(T depth) {
+  const float d = static_cast<float>(depth);
+  uint32_t bits;
+  std::memcpy(&bits, &d, sizeof bits);
+  return bits;
+}
+
+// Gaussian-major slot offsets: Gaussian g owns [start[g], start[g + 1]).
+void count_slots(const PixelRect* rects, int count, TileBins& bins) {
+  bins.gaussian_start.assign(size_t(count) + 1, 0);
+  for (int g = 0; g < count; ++g) {
+    const TileRect t = tiles_of(rects[g]);
+    bins.gaussian_start[g + 1] = bins.gaussian_start[g] + uint64_t(t.x1 - t.x0) * (t.y1 - t.y0);
+  }
+  // Slots are stored as 32-bit indices.
+  if (bins.gaussian_start[count] >= (uint64_t(1) << 32))
+    fail("rasterizer: {} splat-tile pairs exceed the 2^32 limit", bins.gaussian_start[count]);
+}
+
+void fill_slots(const PixelRect* rects, int count, TileBins& bins) {
+  const size_t entries = bins.gaussian_start[count];
+  bins.slot_gaussian.resize(entries);
+  bins.slot_tile.resize(entries);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (int g = 0; g < count; ++g) {
+    const TileRect t = tiles_of(rects[g]);
+    uint64_t slot = bins.gaussian_start[g];
+    for (int ty = t.y0; ty < t.y1; ++ty)
+      for (int tx = t.x0; tx < t.x1; ++tx, ++slot) {
+        bins.slot_gaussian[slot] = uint32_t(g);
+        bins.slot_tile[slot] = uint32_t(ty * bins.tiles_x + tx);
+      }
+  }
+}
+
+template <typename T>
+void group_by_tile(const Splat<T>* splats, TileBins& bins) {
+  const size_t entries = bins.slot_tile.size();
+  bins.tile_start.assign(size_t(bins.tile_count()) + 1, 0);
+  for (size_t s = 0; s < entries; ++s) ++bins.tile_start[bins.slot_tile[s] + 1];
+  for (int t = 0; t < bins.tile_count(); ++t) bins.tile_start[t + 1] += bins.tile_start[t];
+  std::vector<uint32_t> cursor(bins.tile_start.begin(), bins.tile_start.end() - 1);
+  bins.keys.resize(entries);
+  for (size_t s = 0; s < entries; ++s) {
+    const uint32_t g = bins.slot_gaussian[s];
+    bins.keys[cursor[bins.slot_tile[s]]++] = uint64_t(depth_bits(splats[g].depth)) << 32 | s;
+  }
+}
+
+void sort_tiles(TileBins& bins) {
+  bins.entry_gaussian.resize(bins.keys.size());
+  bins.entry_slot.resize(bins.keys.size());
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int t = 0; t < bins.tile_count(); ++t) {
+    const uint32_t begin = bins.tile_start[t], end = bins.tile_start[t + 1];
+    std::sort(bins.keys.begin() + begin, bins.keys.begin() + end);
+    for (uint32_t e = begin; e < end; ++e) {
+      const uint32_t slot = uint32_t(bins.keys[e]);
+      bins.entry_slot[e] = slot;
+      bins.entry_gaussian[e] = bins.slot_gaussian[slot];
+    }
+  }
+}
+
+}  // namespace
+
+template <typename T>
+void bin_splats(const Splat<T>* splats, const PixelRect* rects, int count, int width, int height,
+                TileBins& bins) {
+  bins.tiles_x = (width + kTileSize - 1) / kTileSize;
+  bins.tiles_y = (height + kTileSize - 1) / kTileSize;
+  count_slots(rects, count, bins);
+  fill_slots(rects, count, bins);
+  group_by_tile(splats, bins);
+  sort_tiles(bins);
+}
+
+template void bin_splats(const Splat<float>*, const PixelRect*, int, int, int, TileBins&);
+template void bin_splats(const Splat<double>*, const PixelRect*, int, int, int, TileBins&);
+
+}  // namespace iesrgs::raster::cpu

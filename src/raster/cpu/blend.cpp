@@ -1,0 +1,350 @@
+// Per-tile alpha blending. The loops run splat-major: each splat of a tile (front to back in the
+// forward pass, back to front in the backward pass) visits only the pixels its cut-off ellipse
+// covers, a SIMD pack at a time, with the per-pixel state of the tile in structure-of-arrays
+// buffers. The backward pass recomputes each splat's alphas instead of storing per-pixel lists.
+#include <algorithm>
+#include <cmath>
+
+#include "raster/cpu/kernels.hpp"
+#include "raster/cpu/pack.hpp"
+
+namespace iesrgs::raster::cpu {
+
+namespace {
+
+// A tile's pixel window in the image and a splat's rectangle clipped to it.
+struct TileWindow {
+  int x0, y0, x1, y1;
+
+  TileWindow clip(const PixelRect& r) const {
+    return {std::max(x0, r.x0), std::max(y0, r.y0), std::min(x1, r.x1), std::min(y1, r.y1)};
+  }
+  int local(int x, int y) const { return (y - y0) * kTileSize + (x - x0); }
+};
+
+// Entries name splats in depth order, i.e. at random places in memory: fetch ahead.
+constexpr uint32_t kPrefetchDistance = 4;
+
+template <typename T>
+void prefetch_splat(const RasterFrame<T>& frame, uint32_t entry) {
+  const uint32_t g = frame.bins.entry_gaussian[entry];
+  __builtin_prefetch(&frame.splats[g]);
+  __builtin_prefetch(&frame.rects[g]);
+}
+
+TileWindow tile_window(const TileBins& bins, int tile, int width, int height) {
+  const int x0 = (tile % bins.tiles_x) * kTileSize, y0 = (tile / bins.tiles_x) * kTileSize;
+  return {x0, y0, std::min(x0 + kTileSize, width), std::min(y0 + kTileSize, height)};
+}
+
+// Row by row, the columns where a splat can reach alpha 1/255: the chords of its cut-off ellipse
+// xx dx^2 + 2 xy dx dy + yy dy^2 <= cutoff (dx, dy: mean minus pixel center), clipped to `box`
+// (the splat's rectangle within the tile window) and widened to whole packs of pixels of
+// the tile so that the pixel loops run on full vectors. The extra pixels lie outside the
+// ellipse, where the alpha test rejects them, or off the image, where the pixel state keeps them
+// inert.
+template <typename T>
+class Chords {
+ public:
+  Chords(const Splat<T>& s, const TileWindow& win, const TileWindow& box)
+      : s_(s),
+        win_(win),
+        box_(box),
+        inv_xx_(T(1) / s.conic_xx),
+        slope_(s.conic_xy * inv_xx_),
+        reach_(s.conic_xx * s.cutoff) {}
+
+  // Columns [x, x + n) of row y; false when the row misses the ellipse.
+  bool row(int y, int& x, int& n) const {
+    const T dy = s_.y - (T(y) + T(0.5));
+    const T quarter_disc = reach_ - dy * dy * s_.conic_det;
+    if (!(quarter_disc > T(0))) return false;
+    const T center = s_.x + slope_ * dy;
+    // Half a pixel of slack covers rounding in the chord.
+    const T half = std::sqrt(quarter_disc) * inv_xx_ + T(0.5);
+    // Pixel i is inside when its center i + 0.5 is; the box keeps both ends non-negative, so
+    // integer conversion is floor.
+    const T first = clamp(center - half - T(0.5)), end = clamp(center + half + T(0.5));
+    int lo = int(first);
+    lo += T(lo) < first;
+    const int hi = int(end);
+    if (lo >= hi) return false;
+    x = win_.x0 + ((lo - win_.x0) & ~(kLanes<T> - 1));
+    n = win_.x0 + ((hi - win_.x0 + kLanes<T> - 1) & ~(kLanes<T> - 1)) - x;
+    return true;
+  }
+
+ private:
+  T clamp(T v) const { return std::min(T(box_.x1), std::max(T(box_.x0), v)); }
+
+  const Splat<T>& s_;
+  TileWindow win_, box_;
+  T inv_xx_, slope_, reach_;
+};
+
+template <typename T>
+struct alignas(64) ForwardPixels {
+  T transmittance[kTilePixels];
+  T color[3][kTilePixels];
+  T depth[kTilePixels];
+  T live[kTilePixels];  // 1 until the pixel reaches the transmittance cut-off, then 0
+  uint32_t contributors[kTilePixels];
+};
+
+// Blends splat s (entry number `entry` of its tile) into the pixels [p, p + n) of one row, n a
+// multiple of the pack size, whose first pixel center is at (x + 0.5, y + 0.5). Returns how many
+// pixels reached the cut-off.
+template <typename T>
+int blend_row(const Splat<T>& s, uint32_t entry, int x, int y, int p, int n, ForwardPixels<T>& px) {
+  const T dy = s.y - (T(y) + T(0.5));
+  const Index<T> contributor = Index<T>{} + (entry + 1);
+  int stopped = 0;
+  for (int i = p; i < p + n; i += kLanes<T>, x += kLanes<T>) {
+    const Pack<T> dx = s.x - (T(x) + lane_centers<T>());
+    const Pack<T> power = splat_power(s, dx, broadcast(dy));
+    const Pack<T> a = load(px.live + i) * splat_alpha<T>(power, s.opacity * falloff_exp<T>(power));
+    const Pack<T> trans = load(px.transmittance + i);
+    const Pack<T> next = trans * (T(1) - a);
+    // 3DGS stops a pixel before blending the splat that would drop it below the cut-off.
+    // Where a == 0 nothing changes: next == trans and the weight is 0.
+    const Mask<T> stop = (a > T(0)) & (next < T(kMinTransmittance));
+    const Pack<T> w = select<T>(stop, Pack<T>{}, a * trans);
+    for (int c = 0; c < 3; ++c) store(px.color[c] + i, load(px.color[c] + i) + w * s.color[c]);
+    store(px.depth + i, load(px.depth + i) + w * s.depth);
+    store(px.transmittance + i, select<T>(stop, trans, next));
+    store_index<T>(px.contributors + i,
+                   (w > T(0)) ? contributor : load_index<T>(px.contributors + i));
+    store(px.live + i, select<T>(stop, Pack<T>{}, load(px.live + i)));
+    stopped += count<T>(stop);
+  }
+  return stopped;
+}
+
+template <typename T>
+void blend_tile_forward(RasterFrame<T>& frame, int tile, T* image, T* alpha, T* depth) {
+  const RasterCamera<T>& cam = frame.camera;
+  const TileBins& bins = frame.bins;
+  const TileWindow win = tile_window(bins, tile, cam.width, cam.height);
+  ForwardPixels<T> px;
+  std::fill_n(px.transmittance, kTilePixels, T(1));
+  std::fill_n(&px.color[0][0], 3 * kTilePixels, T(0));
+  std::fill_n(px.depth, kTilePixels, T(0));
+  // Pixels off the image (in border tiles) never blend.
+  std::fill_n(px.live, kTilePixels, T(0));
+  for (int y = win.y0; y < win.y1; ++y)
+    std::fill_n(px.live + win.local(win.x0, y), win.x1 - win.x0, T(1));
+  std::fill_n(px.contributors, kTilePixels, 0u);
+  int active = (win.x1 - win.x0) * (win.y1 - win.y0);
+
+  const uint32_t begin = bins.tile_start[tile], end = bins.tile_start[tile + 1];
+  for (uint32_t e = begin; e < end && active > 0; ++e) {
+    if (e + kPrefetchDistance < end) prefetch_splat(frame, e + kPrefetchDistance);
+    const uint32_t g = bins.entry_gaussian[e];
+    const TileWindow box = win.clip(frame.rects[g]);
+    const Splat<T>& s = frame.splats[g];
+    const Chords<T> chords(s, win, box);
+    int x, n;
+    for (int y = box.y0; y < box.y1; ++y)
+      if (chords.row(y, x, n)) active -= blend_row(s, e - begin, x, y, win.local(x, y), n, px);
+  }
+
+  const size_t plane = size_t(cam.width) * cam.height;
+  for (int y = win.y0; y < win.y1; ++y)
+    for (int x = win.x0; x < win.x1; ++x) {
+      const int p = win.local(x, y);
+      const size_t i = size_t(y) * cam.width + x;
+      for (int c = 0; c < 3; ++c)
+        image[c * plane + i] = px.color[c][p] + px.transmittance[p] * frame.background[c];
+      alpha[i] = T(1) - px.transmittance[p];
+      depth[i] = px.depth[p];
+      frame.final_transmittance[i] = px.transmittance[p];
+      frame.contributors[i] = px.contributors[p];
+    }
+}
+
+// Backward per-pixel state. The color and depth gradients are constant per pixel, so what a
+// splat hides only matters through its loss-weighted value: behind = dL/dcolor . color_behind +
+// dL/ddepth . depth_behind, blended back to front like the colors themselves.
+template <typename T>
+struct alignas(64) BackwardPixels {
+  T transmittance[kTilePixels];  // in front of the current splat
+  uint32_t contributors[kTilePixels];
+  T dcolor[3][kTilePixels];
+  T ddepth[kTilePixels];
+  // final transmittance x (d(alpha output) - background . d(color)): how the loss moves with
+  // the light that passes every splat.
+  T dfinal[kTilePixels];
+  T behind[kTilePixels];
+};
+
+template <typename T>
+uint32_t load_backward_pixels(const RasterFrame<T>& frame, const TileWindow& win, const T* dimage,
+                              const T* dalpha, const T* ddepth, BackwardPixels<T>& px) {
+  const RasterCamera<T>& cam = frame.camera;
+  const size_t plane = size_t(cam.width) * cam.height;
+  uint32_t last = 0;
+  for (int y = win.y0; y < win.y1; ++y)
+    for (int x = win.x0; x < win.x1; ++x) {
+      const int p = win.local(x, y);
+      const size_t i = size_t(y) * cam.width + x;
+      px.transmittance[p] = frame.final_transmittance[i];
+      px.contributors[p] = frame.contributors[i];
+      last = std::max(last, px.contributors[p]);
+      T dfinal = dalpha ? dalpha[i] : T(0);
+      for (int c = 0; c < 3; ++c) {
+        px.dcolor[c][p] = dimage ? dimage[c * plane + i] : T(0);
+        dfinal -= frame.background[c] * px.dcolor[c][p];
+      }
+      px.dfinal[p] = frame.final_transmittance[i] * dfinal;
+      px.ddepth[p] = ddepth ? ddepth[i] : T(0);
+      px.behind[p] = T(0);
+    }
+  return last;
+}
+
+// A splat's gradient summed lane-wise over its pixels; reduced across lanes once per splat.
+template <typename T>
+struct PackedGrad {
+  Pack<T> x{}, y{}, conic_xx{}, conic_xy{}, conic_yy{}, opacity{};
+  Pack<T> color[3] = {};
+  Pack<T> depth{}, abs_x{}, abs_y{};
+
+  SplatGrad<T> sum() const {
+    return {horizontal_sum<T>(x),
+            horizontal_sum<T>(y),
+            horizontal_sum<T>(conic_xx),
+            horizontal_sum<T>(conic_xy),
+            horizontal_sum<T>(conic_yy),
+            horizontal_sum<T>(opacity),
+            {horizontal_sum<T>(color[0]), horizontal_sum<T>(color[1]), horizontal_sum<T>(color[2])},
+            horizontal_sum<T>(depth),
+            horizontal_sum<T>(abs_x),
+            horizontal_sum<T>(abs_y)};
+  }
+};
+
+// Adds to acc the gradient of the pixels [p, p + n) of one row (n a multiple of the pack size) with
+// respect to splat s (entry number `entry` of its tile), and moves their state in front of s.
+// Pixels that did not blend s get alpha 0, which leaves their state unchanged and adds nothing.
+template <typename T>
+void backward_row(const Splat<T>& s, uint32_t entry, int x, int y, int p, int n,
+                  BackwardPixels<T>& px, PackedGrad<T>& acc) {
+  const T dy = s.y - (T(y) + T(0.5));
+  const Index<T> entries = Index<T>{} + entry;
+  for (int i = p; i < p + n; i += kLanes<T>, x += kLanes<T>) {
+    const Pack<T> dx = s.x - (T(x) + lane_centers<T>());
+    const Pack<T> power = splat_power(s, dx, broadcast(dy));
+    const Pack<T> falloff = falloff_exp<T>(power);
+    const Pack<T> weight = s.opacity * falloff;
+    const Pack<T> a = select<T>(entries < load_index<T>(px.contributors + i),
+                                splat_alpha<T>(power, weight), Pack<T>{});
+    const Pack<T> inv_opaque = T(1) / (T(1) - a);
+    const Pack<T> t_front = load(px.transmittance + i) * inv_opaque;
+    const Pack<T> w = a * t_front;
+    // The splat's own loss-weighted color and depth.
+    Pack<T> value = s.depth * load(px.ddepth + i);
+    acc.depth += w * load(px.ddepth + i);
+    for (int c = 0; c < 3; ++c) {
+      const Pack<T> dcolor = load(px.dcolor[c] + i);
+      acc.color[c] += w * dcolor;
+      value += s.color[c] * dcolor;
+    }
+    // d(loss)/d(alpha): the splat's value minus what it hides, and the final transmittance
+    // (alpha output and background) shrinking with every blended alpha.
+    const Pack<T> behind = load(px.behind + i);
+    const Pack<T> da = t_front * (value - behind) + inv_opaque * load(px.dfinal + i);
+    store(px.behind + i, a * value + (T(1) - a) * behind);
+    store(px.transmittance + i, t_front);
+    // Alpha capped at 0.99 passes no gradient to opacity or shape.
+    const Pack<T> da_live = select<T>((a > T(0)) & (weight <= T(kMaxAlpha)), da, Pack<T>{});
+    acc.opacity += da_live * falloff;
+    const Pack<T> dpower = a * da_live;
+    const Pack<T> dmx = -dpower * (s.conic_xx * dx + s.conic_xy * dy);
+    const Pack<T> dmy = -dpower * (s.conic_yy * dy + s.conic_xy * dx);
+    acc.x += dmx;
+    acc.y += dmy;
+    acc.abs_x += abs<T>(dmx);
+    acc.abs_y += abs<T>(dmy);
+    acc.conic_xx += T(-0.5) * dx * dx * dpower;
+    acc.conic_xy += -dx * dy * dpower;
+    acc.conic_yy += T(-0.5) * dy * dy * dpower;
+  }
+}
+
+template <typename T>
+void blend_tile_backward(RasterFrame<T>& frame, int tile, const T* dimage, const T* dalpha,
+                         const T* ddepth) {
+  const TileBins& bins = frame.bins;
+  const TileWindow win = tile_window(bins, tile, frame.camera.width, frame.camera.height);
+  BackwardPixels<T> px{};  // zero, so that pixels off the image stay inert
+  const uint32_t last = load_backward_pixels(frame, win, dimage, dalpha, ddepth, px);
+  const uint32_t begin = bins.tile_start[tile], end = bins.tile_start[tile + 1];
+  // Entries no pixel blended get zero partials.
+  for (uint32_t e = begin + last; e < end; ++e) frame.entry_grads[bins.entry_slot[e]] = {};
+  for (uint32_t k = last; k-- > 0;) {
+    if (k >= kPrefetchDistance) prefetch_splat(frame, begin + k - kPrefetchDistance);
+    const uint32_t g = bins.entry_gaussian[begin + k];
+    const TileWindow box = win.clip(frame.rects[g]);
+    PackedGrad<T> acc;
+    const Splat<T>& s = frame.splats[g];
+    const Chords<T> chords(s, win, box);
+    int x, n;
+    for (int y = box.y0; y < box.y1; ++y)
+      if (chords.row(y, x, n)) backward_row(s, k, x, y, win.local(x, y), n, px, acc);
+    frame.entry_grads[bins.entry_slot[begin + k]] = acc.sum();
+  }
+}
+
+// Sums each Gaussian's per-entry partials, which sit in its contiguous slots.
+template <typename T>
+void reduce_entry_grads(RasterFrame<T>& frame) {
+  const int count = int(frame.splats.size());
+  const auto& start = frame.bins.gaussian_start;
+#pragma omp parallel for schedule(static)
+  for (int g = 0; g < count; ++g) {
+    SplatGrad<T> sum{};
+    for (uint64_t s = start[g]; s < start[g + 1]; ++s) {
+      const SplatGrad<T>& e = frame.entry_grads[s];
+      sum.x += e.x;
+      sum.y += e.y;
+      sum.conic_xx += e.conic_xx;
+      sum.conic_xy += e.conic_xy;
+      sum.conic_yy += e.conic_yy;
+      sum.opacity += e.opacity;
+      for (int c = 0; c < 3; ++c) sum.color[c] += e.color[c];
+      sum.depth += e.depth;
+      sum.abs_x += e.abs_x;
+      sum.abs_y += e.abs_y;
+    }
+    frame.splat_grads[g] = sum;
+  }
+}
+
+}  // namespace
+
+template <typename T>
+void blend_forward(RasterFrame<T>& frame, T* image, T* alpha, T* depth) {
+  const size_t pixels = size_t(frame.camera.width) * frame.camera.height;
+  frame.final_transmittance.resize(pixels);
+  frame.contributors.resize(pixels);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int t = 0; t < frame.bins.tile_count(); ++t)
+    blend_tile_forward(frame, t, image, alpha, depth);
+}
+
+template <typename T>
+void blend_backward(RasterFrame<T>& frame, const T* dimage, const T* dalpha, const T* ddepth) {
+  frame.entry_grads.resize(frame.bins.entry_count());
+  frame.splat_grads.resize(frame.splats.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int t = 0; t < frame.bins.tile_count(); ++t)
+    blend_tile_backward(frame, t, dimage, dalpha, ddepth);
+  reduce_entry_grads(frame);
+}
+
+template void blend_forward(RasterFrame<float>&, float*, float*, float*);
+template void blend_forward(RasterFrame<double>&, double*, double*, double*);
+template void blend_backward(RasterFrame<float>&, const float*, const float*, const float*);
+template void blend_backward(RasterFrame<double>&, const double*, const double*, const double*);
+
+}  // namespace iesrgs::raster::cpu

@@ -1,0 +1,114 @@
+#include "raster/rasterizer.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "core/error.hpp"
+#include "gs/sh.hpp"
+#include "raster/cpu/kernels.hpp"
+
+namespace iesrgs::raster {
+
+namespace {
+
+class StageTimer {
+ public:
+  // Milliseconds since construction or the previous call.
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+    return ms;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+template <typename T>
+void validate(const GaussianParams<T>& g, const RasterCamera<T>& cam) {
+  if (cam.width <= 0 || cam.height <= 0)
+    fail("rasterizer: image size {}x{} is not positive", cam.width, cam.height);
+  if (!(cam.fx > 0 && cam.fy > 0))
+    fail("rasterizer: focal lengths {} {} are not positive", cam.fx, cam.fy);
+  if (g.count < 0) fail("rasterizer: negative Gaussian count {}", g.count);
+  if (g.sh_degree < 0 || g.sh_degree > gs::kMaxShDegree)
+    fail("rasterizer: SH degree {} is outside 0..{}", g.sh_degree, gs::kMaxShDegree);
+  if (g.count > 0 && !(g.means && g.log_scales && g.quats && g.opacity_logits && g.sh))
+    fail("rasterizer: a Gaussian parameter array is missing");
+}
+
+template <typename T>
+void zero(T* data, size_t count) {
+  if (data) std::fill_n(data, count, T(0));
+}
+
+}  // namespace
+
+template <typename T>
+RasterCamera<T> raster_camera(const Camera& camera) {
+  RasterCamera<T> c;
+  const Intrinsics& k = camera.intrinsics;
+  c.width = k.width;
+  c.height = k.height;
+  c.fx = T(k.fx);
+  c.fy = T(k.fy);
+  c.cx = T(k.cx);
+  c.cy = T(k.cy);
+  for (int i = 0; i < 9; ++i) c.rotation[i] = T(camera.rotation.m[i]);
+  for (int i = 0; i < 3; ++i) c.translation[i] = T(camera.translation[i]);
+  return c;
+}
+
+template <typename T>
+void rasterize_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
+                       const T background[3], RasterFrame<T>& frame, const RenderTargets<T>& out) {
+  validate(g, cam);
+  frame.camera = cam;
+  std::copy_n(background, 3, frame.background);
+  frame.splats.resize(g.count);
+  frame.rects.resize(g.count);
+  StageTimer timer;
+  cpu::project_forward(g, cam, frame.splats.data(), frame.rects.data(), out.radii);
+  frame.timings.project = timer.lap();
+  cpu::bin_splats(frame.splats.data(), frame.rects.data(), g.count, cam.width, cam.height,
+                  frame.bins);
+  frame.timings.bin = timer.lap();
+  cpu::blend_forward(frame, out.image, out.alpha, out.depth);
+  frame.timings.blend = timer.lap();
+}
+
+template <typename T>
+void rasterize_backward(const GaussianParams<T>& g, RasterFrame<T>& frame,
+                        const PixelGrads<T>& pixel_grads, const GaussianGrads<T>& grads) {
+  if (size_t(g.count) != frame.splats.size())
+    fail("rasterizer: backward got {} Gaussians, forward rendered {}", g.count,
+         frame.splats.size());
+  const size_t n = size_t(g.count);
+  zero(grads.means, 3 * n);
+  zero(grads.log_scales, 3 * n);
+  zero(grads.quats, 4 * n);
+  zero(grads.opacity_logits, n);
+  zero(grads.sh, 3 * gs::kShCoefficients * n);
+  zero(grads.viewspace, 2 * n);
+  zero(grads.viewspace_abs, 2 * n);
+  StageTimer timer;
+  cpu::blend_backward(frame, pixel_grads.image, pixel_grads.alpha, pixel_grads.depth);
+  frame.timings.blend_backward = timer.lap();
+  cpu::project_backward(g, frame.camera, frame.splat_grads.data(), grads);
+  frame.timings.project_backward = timer.lap();
+}
+
+template RasterCamera<float> raster_camera(const Camera&);
+template RasterCamera<double> raster_camera(const Camera&);
+template void rasterize_forward(const GaussianParams<float>&, const RasterCamera<float>&,
+                                const float[3], RasterFrame<float>&, const RenderTargets<float>&);
+template void rasterize_forward(const GaussianParams<double>&, const RasterCamera<double>&,
+                                const double[3], RasterFrame<double>&,
+                                const RenderTargets<double>&);
+template void rasterize_backward(const GaussianParams<float>&, RasterFrame<float>&,
+                                 const PixelGrads<float>&, const GaussianGrads<float>&);
+template void rasterize_backward(const GaussianParams<double>&, RasterFrame<double>&,
+                                 const PixelGrads<double>&, const GaussianGrads<double>&);
+
+}  // namespace iesrgs::raster

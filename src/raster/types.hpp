@@ -1,0 +1,81 @@
+#pragma once
+// Plain data shared by the raster kernels: camera, Gaussian parameters, per-Gaussian splats.
+#include <cstdint>
+
+#include "raster/hd.hpp"
+
+namespace iesrgs::raster {
+
+constexpr int kTileSize = 16;
+constexpr int kTilePixels = kTileSize * kTileSize;
+
+// Pinhole camera, OpenCV convention (x right, y down, z forward), pixel centers at +0.5.
+template <typename T>
+struct RasterCamera {
+  int width = 0, height = 0;
+  T fx = 0, fy = 0, cx = 0, cy = 0;
+  T rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // world-to-camera, row-major
+  T translation[3] = {0, 0, 0};                 // world-to-camera
+};
+
+// Non-owning view of N Gaussians, row-major arrays.
+template <typename T>
+struct GaussianParams {
+  int count = 0;
+  int sh_degree = 0;                  // active degree 0..3
+  const T* means = nullptr;           // (N, 3)
+  const T* log_scales = nullptr;      // (N, 3)
+  const T* quats = nullptr;           // (N, 4) w x y z, unnormalized
+  const T* opacity_logits = nullptr;  // (N)
+  const T* sh = nullptr;              // (N, 16, 3)
+  const T* filter_std = nullptr;      // (N) Mip-Splatting 3D filter; nullptr means none
+};
+
+// Gradients with respect to GaussianParams, same shapes, plus the screen-space gradients that
+// drive densification.
+template <typename T>
+struct GaussianGrads {
+  T* means = nullptr;
+  T* log_scales = nullptr;
+  T* quats = nullptr;
+  T* opacity_logits = nullptr;
+  T* sh = nullptr;
+  // (N, 2) gradient of the projected mean in NDC units ([-1, 1] across the image), as 3DGS
+  // reports it, so its 2e-4 densification threshold applies; and the sum over pixels of the
+  // absolute per-pixel contributions (Mip-Splatting / GOF), same units.
+  T* viewspace = nullptr;
+  T* viewspace_abs = nullptr;
+};
+
+// What the blending needs of a projected Gaussian, precomputed once per frame.
+template <typename T>
+struct Splat {
+  T x, y;                          // mean in pixels
+  T conic_xx, conic_xy, conic_yy;  // inverse of the filtered 2D covariance
+  T opacity;                       // after sigmoid and both Mip-Splatting filters
+  T color[3];
+  T depth;  // camera-space z
+  // Footprint, for loop bounds only: alpha is below 1/255 wherever the Mahalanobis distance
+  // d^T conic d exceeds `cutoff` (0 when the splat can never reach it); conic_det = det(conic).
+  T cutoff, conic_det;
+};
+
+// Gradient of the loss with respect to every Splat field, plus the absolute screen-space sums.
+template <typename T>
+struct SplatGrad {
+  T x, y;
+  T conic_xx, conic_xy, conic_yy;
+  T opacity;
+  T color[3];
+  T depth;
+  T abs_x, abs_y;
+};
+
+// Half-open pixel rectangle [x0, x1) x [y0, y1) outside which a splat's alpha is below 1/255.
+struct PixelRect {
+  int32_t x0, y0, x1, y1;
+
+  IESRGS_HD bool empty() const { return x0 >= x1 || y0 >= y1; }
+};
+
+}  // namespace iesrgs::raster
