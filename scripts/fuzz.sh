@@ -24,6 +24,14 @@ if [[ ${#names[@]} -eq 0 ]]; then
   exit 1
 fi
 
+if ! command -v "${CXX:-clang++}" >/dev/null; then
+  echo "fuzz: installing clang (libFuzzer)"
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends clang
+fi
+
 targets=()
 for name in "${names[@]}"; do targets+=("iesrgs_${name}_fuzzer"); done
 CXX=${CXX:-clang++} cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
