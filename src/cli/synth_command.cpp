@@ -14,8 +14,8 @@ namespace iesrgs::cli {
 void add_synth_command(CLI::App& app) {
   auto* command = app.add_subcommand(
       "synth",
-      "Render the built-in synthetic scene as a NeRF-Synthetic dataset: RGBA PNGs, "
-      "transforms_train/test.json and ground-truth depth (.npy)");
+      "Render the built-in synthetic scene as a dataset with ground-truth depth (.npy): "
+      "NeRF-Synthetic layout (RGBA PNGs, transforms_train/test.json) or a COLMAP capture");
   auto output = std::make_shared<std::string>();
   auto options = std::make_shared<synth::SynthOptions>();
   command->add_option("-o,--output", *output, "Directory to write the scene into")->required();
