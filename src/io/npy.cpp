@@ -1,7 +1,9 @@
 #include "io/npy.hpp"
 
+#include <cctype>
+#include <charconv>
+#include <cstdint>
 #include <cstring>
-#include <regex>
 #include <string>
 
 #include "core/error.hpp"
@@ -57,16 +59,25 @@ NpyArray read_npy(const fs::path& path) {
     fail_file(path, "only little-endian float32 ('<f4') arrays are supported");
   if (header.find("'fortran_order': False") == std::string::npos)
     fail_file(path, "Fortran-order arrays are not supported");
-  std::smatch match;
-  if (!std::regex_search(header, match, std::regex("'shape':\\s*\\(([^)]*)\\)")))
+  const size_t key = header.find("'shape':");
+  const size_t open = header.find('(', key);
+  const size_t close = header.find(')', open);
+  if (key == std::string::npos || open == std::string::npos || close == std::string::npos)
     fail_file(path, "malformed .npy header (no shape)");
   NpyArray array;
   size_t count = 1;
-  const std::string dims = match[1].str();
-  const std::regex number("\\d+");
-  for (std::sregex_iterator it(dims.begin(), dims.end(), number), end; it != end; ++it) {
-    array.shape.push_back(std::stoull(it->str()));
-    count *= array.shape.back();
+  for (size_t pos = open + 1; pos < close;) {
+    if (!std::isdigit(static_cast<unsigned char>(header[pos]))) {
+      ++pos;  // separators: ", "
+      continue;
+    }
+    size_t dim = 0;
+    const auto [end, error] = std::from_chars(header.data() + pos, header.data() + close, dim);
+    if (error != std::errc() || (dim && count > SIZE_MAX / sizeof(float) / dim))
+      fail_file(path, "malformed .npy header (bad shape)");
+    array.shape.push_back(dim);
+    count *= dim;
+    pos = size_t(end - header.data());
   }
   const size_t data_offset = offset + header_len;
   if (bytes.size() - data_offset != count * sizeof(float))
