@@ -11,6 +11,7 @@
 #include "cli/commands.hpp"
 #include "core/error.hpp"
 #include "gs/sh.hpp"
+#include "raster/cpu/dispatch.hpp"
 #include "raster/rasterizer.hpp"
 #include "raster/synthetic_scene.hpp"
 
@@ -84,6 +85,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
       "(medians)\n",
       n, drawn, args.width, args.height, frame.bins.entry_count(), omp_get_max_threads(),
       args.iterations);
+  fmt::print("blend kernels: {}\n", cpu::describe_isa(cpu::active_isa()));
   fmt::print("forward: {:.1f} ms\n", median(forward));
   fmt::print("forward+backward: {:.1f} ms\n", median(total));
   fmt::print("  projection: {:.1f} ms\n", median(project));

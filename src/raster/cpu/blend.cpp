@@ -2,13 +2,14 @@
 // forward pass, back to front in the backward pass) visits only the pixels its cut-off ellipse
 // covers, a SIMD pack at a time, with the per-pixel state of the tile in structure-of-arrays
 // buffers. The backward pass recomputes each splat's alphas instead of storing per-pixel lists.
+// Compiled once per instruction-set variant (isa.hpp), each into its own namespace.
 #include <algorithm>
 #include <cmath>
 
-#include "raster/cpu/kernels.hpp"
+#include "raster/cpu/blend.hpp"
 #include "raster/cpu/pack.hpp"
 
-namespace iesrgs::raster::cpu {
+namespace iesrgs::raster::cpu::IESRGS_CPU_ISA_NAMESPACE {
 
 namespace {
 
@@ -320,31 +321,29 @@ void reduce_entry_grads(RasterFrame<T>& frame) {
   }
 }
 
-}  // namespace
-
 template <typename T>
-void blend_forward(RasterFrame<T>& frame, T* image, T* alpha, T* depth) {
-  const size_t pixels = size_t(frame.camera.width) * frame.camera.height;
-  frame.final_transmittance.resize(pixels);
-  frame.contributors.resize(pixels);
+void forward_pass(RasterFrame<T>& frame, T* image, T* alpha, T* depth) {
 #pragma omp parallel for schedule(dynamic, 1)
   for (int t = 0; t < frame.bins.tile_count(); ++t)
     blend_tile_forward(frame, t, image, alpha, depth);
 }
 
 template <typename T>
-void blend_backward(RasterFrame<T>& frame, const T* dimage, const T* dalpha, const T* ddepth) {
-  frame.entry_grads.resize(frame.bins.entry_count());
-  frame.splat_grads.resize(frame.splats.size());
+void backward_pass(RasterFrame<T>& frame, const T* dimage, const T* dalpha, const T* ddepth) {
 #pragma omp parallel for schedule(dynamic, 1)
   for (int t = 0; t < frame.bins.tile_count(); ++t)
     blend_tile_backward(frame, t, dimage, dalpha, ddepth);
   reduce_entry_grads(frame);
 }
 
-template void blend_forward(RasterFrame<float>&, float*, float*, float*);
-template void blend_forward(RasterFrame<double>&, double*, double*, double*);
-template void blend_backward(RasterFrame<float>&, const float*, const float*, const float*);
-template void blend_backward(RasterFrame<double>&, const double*, const double*, const double*);
+}  // namespace
 
-}  // namespace iesrgs::raster::cpu
+template <typename T>
+BlendPasses<T> blend_passes() {
+  return {forward_pass<T>, backward_pass<T>, kPackBytes};
+}
+
+template BlendPasses<float> blend_passes();
+template BlendPasses<double> blend_passes();
+
+}  // namespace iesrgs::raster::cpu::IESRGS_CPU_ISA_NAMESPACE

@@ -19,7 +19,8 @@ void bin_splats(const Splat<T>* splats, const PixelRect* rects, int count, int w
                 TileBins& bins);
 
 // Front-to-back blending of every tile; fills the frame's per-pixel state for the backward pass.
-// image (3, H, W), alpha and depth (H, W); depth is the alpha-blended camera z.
+// image (3, H, W), alpha and depth (H, W); depth is the alpha-blended camera z. Both blend passes
+// run the active instruction-set variant (dispatch.hpp).
 template <typename T>
 void blend_forward(RasterFrame<T>& frame, T* image, T* alpha, T* depth);
 // Back-to-front pass over every tile: per-entry partial gradients, reduced into

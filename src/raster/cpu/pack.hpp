@@ -1,15 +1,17 @@
 #pragma once
 // SIMD packs for the CPU pixel loops, with GCC / Clang vector extensions: the compilers do not
 // auto-vectorize the blending loops (their selects defeat if-conversion). Packs are as wide as
-// the build's vector unit: 16 bytes (SSE2, the baseline of portable x86-64 builds: four float
-// lanes), 32 bytes where the build targets AVX2 (-DIESRGS_NATIVE=ON on such a machine). Double
-// packs let the same kernels run in double for the gradient checks.
+// the compilation's vector unit: 16 bytes (SSE2, the baseline of portable x86-64 builds: four
+// float lanes), 32 bytes where it targets AVX2 (the AVX2 variant, or -DIESRGS_NATIVE=ON on such a
+// machine). Double packs let the same kernels run in double for the gradient checks. Everything
+// here depends on the width, hence lives in the variant's namespace (isa.hpp).
 #include <cstdint>
 #include <cstring>
 
 #include "raster/blend_math.hpp"
+#include "raster/cpu/isa.hpp"
 
-namespace iesrgs::raster::cpu {
+namespace iesrgs::raster::cpu::IESRGS_CPU_ISA_NAMESPACE {
 
 #if defined(__AVX2__)
 constexpr int kPackBytes = 32;
@@ -152,4 +154,4 @@ inline Pack<T> splat_alpha(Pack<T> power, Pack<T> weight) {
   return select<T>((alpha < T(kMinAlpha)) | (power > T(0)), Pack<T>{}, alpha);
 }
 
-}  // namespace iesrgs::raster::cpu
+}  // namespace iesrgs::raster::cpu::IESRGS_CPU_ISA_NAMESPACE
