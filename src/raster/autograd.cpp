@@ -62,17 +62,19 @@ const float* data_or_null(const Tensor& t) {
 
 class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
  public:
-  // Probes are inputs only so that autograd routes the screen-space gradients to them.
+  // Probes are inputs only so that autograd routes the screen-space gradients to them. Optional
+  // inputs arrive as empty placeholders (autograd cannot take undefined tensors) with a flag.
   static variable_list forward(AutogradContext* ctx, Tensor means, Tensor log_scales, Tensor quats,
-                               Tensor logits, Tensor sh, Tensor filter_std, Tensor probe,
-                               Tensor abs_probe, RasterCamera<float> camera,
-                               std::array<float, 3> background, int64_t sh_degree) {
+                               Tensor logits, Tensor sh, Tensor filter_std, Tensor /*probe*/,
+                               Tensor /*abs_probe*/, RasterCamera<float> camera,
+                               std::array<float, 3> background, int64_t sh_degree,
+                               std::array<bool, 3> present) {
     means = means.contiguous();
     log_scales = log_scales.contiguous();
     quats = quats.contiguous();
     logits = logits.contiguous();
     sh = sh.contiguous();
-    if (filter_std.defined()) filter_std = filter_std.contiguous();
+    filter_std = present[0] ? filter_std.contiguous() : Tensor();
     const GaussianParams<float> g =
         params_of(means, log_scales, quats, logits, sh, filter_std, int(sh_degree));
     auto holder = c10::make_intrusive<FrameHolder>();
@@ -87,8 +89,8 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     ctx->save_for_backward({means, log_scales, quats, logits, sh, filter_std});
     ctx->saved_data["frame"] = c10::IValue::make_capsule(holder);
     ctx->saved_data["sh_degree"] = sh_degree;
-    ctx->saved_data["probe"] = probe.defined();
-    ctx->saved_data["abs_probe"] = abs_probe.defined();
+    ctx->saved_data["probe"] = present[1];
+    ctx->saved_data["abs_probe"] = present[2];
     ctx->mark_non_differentiable({radii});
     return {image, alpha, depth, radii};
   }
@@ -119,8 +121,8 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
                              dsh.data_ptr<float>(),
                              dprobe.defined() ? dprobe.data_ptr<float>() : nullptr,
                              dabs_probe.defined() ? dabs_probe.data_ptr<float>() : nullptr});
-    return {dmeans, dlog_scales, dquats,   dlogits,  dsh,     Tensor(),
-            dprobe, dabs_probe,  Tensor(), Tensor(), Tensor()};
+    return {dmeans, dlog_scales, dquats,   dlogits,  dsh,      Tensor(),
+            dprobe, dabs_probe,  Tensor(), Tensor(), Tensor(), Tensor()};
   }
 };
 
@@ -129,10 +131,13 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
 RenderOutput render(const GaussianTensors& gaussians, const RasterCamera<float>& camera,
                     const std::array<float, 3>& background, const ViewspaceProbes& probes) {
   check_inputs(gaussians, probes);
+  const auto or_placeholder = [](const Tensor& t) { return t.defined() ? t : torch::empty({0}); };
   const variable_list out = RasterizeFunction::apply(
       gaussians.means, gaussians.log_scales, gaussians.quats, gaussians.opacity_logits,
-      gaussians.sh, gaussians.filter_std, probes.grad, probes.abs_grad, camera, background,
-      int64_t(gaussians.sh_degree));
+      gaussians.sh, or_placeholder(gaussians.filter_std), or_placeholder(probes.grad),
+      or_placeholder(probes.abs_grad), camera, background, int64_t(gaussians.sh_degree),
+      std::array<bool, 3>{gaussians.filter_std.defined(), probes.grad.defined(),
+                          probes.abs_grad.defined()});
   return {out[0], out[1], out[2], out[3]};
 }
 

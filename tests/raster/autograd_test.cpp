@@ -60,6 +60,31 @@ TEST(RasterAutograd, GradientsMatchTheRawBackward) {
   EXPECT_GT(torch::abs(g.means.grad()).sum().item<float>(), 0.f);
 }
 
+TEST(RasterAutograd, FilterAndProbesAreOptional) {
+  const Camera cam = posed_test_camera(32, 24);
+  const Scene<float> s = random_scene(cam, 20, 1, 5).cast<float>();
+  const int64_t n = s.count();
+  GaussianTensors g{tensor_of(s.means, {n, 3}),
+                    tensor_of(s.log_scales, {n, 3}),
+                    tensor_of(s.quats, {n, 4}),
+                    tensor_of(s.logits, {n}),
+                    tensor_of(s.sh, {n, 16, 3}),
+                    torch::Tensor(),
+                    s.degree};
+  const RenderOutput plain = render(g, raster_camera<float>(cam), {1, 1, 1});
+  plain.image.sum().backward();
+  const torch::Tensor grad_without_filter = g.means.grad().clone();
+  EXPECT_GT(grad_without_filter.abs().sum().item<float>(), 0.f);
+
+  // A zero filter renders exactly what no filter renders.
+  g.means.grad().zero_();
+  g.filter_std = torch::zeros({n});
+  const RenderOutput zero_filter = render(g, raster_camera<float>(cam), {1, 1, 1});
+  zero_filter.image.sum().backward();
+  EXPECT_TRUE(torch::equal(zero_filter.image, plain.image));
+  EXPECT_TRUE(torch::equal(g.means.grad(), grad_without_filter));
+}
+
 TEST(RasterAutograd, RejectsWrongShapes) {
   const Camera cam = test_camera(16, 16);
   GaussianTensors g{torch::zeros({4, 3}),
