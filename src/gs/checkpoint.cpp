@@ -1,0 +1,88 @@
+#include "gs/checkpoint.hpp"
+
+#include <torch/serialize.h>
+
+#include <string>
+
+#include "core/error.hpp"
+#include "gs/sh.hpp"
+#include "io/atomic_file.hpp"
+
+namespace iesrgs::gs {
+
+namespace {
+
+const char* const kModelKeys[kParamCount] = {"model/means",      "model/sh_dc",
+                                             "model/sh_rest",    "model/opacity_logits",
+                                             "model/log_scales", "model/quats"};
+
+void save_model(torch::serialize::OutputArchive& archive, const GaussianModel& model) {
+  for (int p = 0; p < kParamCount; ++p)
+    archive.write(kModelKeys[p], model.param(Param(p)).detach());
+  archive.write("model/active_sh_degree", torch::tensor(int64_t(model.active_sh_degree)));
+  if (model.filter_3d.defined()) archive.write("model/filter_3d", model.filter_3d);
+}
+
+void check_model(const GaussianModel& model) {
+  const int64_t n = model.size();
+  const std::vector<int64_t> expected[kParamCount] = {
+      {n, 3}, {n, 1, 3}, {n, kShCoefficients - 1, 3}, {n}, {n, 3}, {n, 4}};
+  for (int p = 0; p < kParamCount; ++p)
+    if (model.param(Param(p)).sizes() != c10::IntArrayRef(expected[p]) ||
+        model.param(Param(p)).scalar_type() != torch::kFloat32)
+      fail("{} has shape {}", kModelKeys[p], c10::str(model.param(Param(p)).sizes()));
+  if (model.filter_3d.defined() && model.filter_3d.sizes() != c10::IntArrayRef{n})
+    fail("model/filter_3d has shape {}", c10::str(model.filter_3d.sizes()));
+  if (model.active_sh_degree < 0 || model.active_sh_degree > kMaxShDegree)
+    fail("active SH degree {} is out of range", model.active_sh_degree);
+}
+
+GaussianModel load_model(torch::serialize::InputArchive& archive) {
+  GaussianModel model;
+  std::array<torch::Tensor, kParamCount> params;
+  for (int p = 0; p < kParamCount; ++p) archive.read(kModelKeys[p], params[p]);
+  model.set_params(params);
+  torch::Tensor degree;
+  archive.read("model/active_sh_degree", degree);
+  if (degree.numel() != 1) fail("model/active_sh_degree is not a scalar");
+  model.active_sh_degree = int(degree.item<int64_t>());
+  torch::Tensor filter;
+  if (archive.try_read("model/filter_3d", filter)) model.filter_3d = filter.contiguous();
+  if (model.means.dim() != 2) fail("model/means is not a matrix");
+  check_model(model);
+  return model;
+}
+
+}  // namespace
+
+void save_training_state(const std::filesystem::path& path, const GaussianModel& model,
+                         const GaussianOptimizer& optimizer, const DensifyStats& stats) {
+  torch::serialize::OutputArchive archive;
+  save_model(archive, model);
+  optimizer.save_state(archive);
+  stats.save(archive);
+  write_atomically(path, [&](const std::filesystem::path& tmp) { archive.save_to(tmp.string()); });
+}
+
+void load_training_state(const std::filesystem::path& path, GaussianModel& model,
+                         GaussianOptimizer& optimizer, DensifyStats& stats) {
+  try {
+    torch::serialize::InputArchive archive;
+    archive.load_from(path.string());
+    GaussianModel loaded_model = load_model(archive);
+    GaussianOptimizer loaded_optimizer = optimizer;
+    loaded_optimizer.load_state(archive, loaded_model);
+    DensifyStats loaded_stats;
+    loaded_stats.load(archive, loaded_model.size());
+    model = std::move(loaded_model);
+    optimizer = std::move(loaded_optimizer);
+    stats = std::move(loaded_stats);
+  } catch (const c10::Error& e) {
+    const std::string why = e.what_without_backtrace();
+    fail_file(path, "not a readable training checkpoint (" + why.substr(0, why.find('\n')) + ")");
+  } catch (const Error& e) {
+    fail_file(path, e.what());
+  }
+}
+
+}  // namespace iesrgs::gs

@@ -1,0 +1,21 @@
+#pragma once
+// Everything training needs to resume exactly where it stopped: the model, the Adam moments
+// and step count, and the densification accumulators, in one torch archive.
+#include <filesystem>
+
+#include "gs/densify.hpp"
+#include "gs/model.hpp"
+#include "gs/optimizer.hpp"
+
+namespace iesrgs::gs {
+
+// Written atomically.
+void save_training_state(const std::filesystem::path& path, const GaussianModel& model,
+                         const GaussianOptimizer& optimizer, const DensifyStats& stats);
+
+// Replaces all three with the stored state, bit for bit; the optimizer keeps its learning-rate
+// settings. Throws Error naming the file when it is unreadable or inconsistent.
+void load_training_state(const std::filesystem::path& path, GaussianModel& model,
+                         GaussianOptimizer& optimizer, DensifyStats& stats);
+
+}  // namespace iesrgs::gs

@@ -1,0 +1,177 @@
+#include "gs/densify.hpp"
+
+#include "core/error.hpp"
+
+namespace iesrgs::gs {
+
+namespace {
+
+using torch::Tensor;
+
+constexpr double kSplitScaleDivisor = 0.8 * 2;  // 3DGS: scale / (0.8 * N) with N = 2 samples
+constexpr int kSplitSamples = 2;
+
+void check_rows(const Tensor& t, int64_t n, const char* name) {
+  if (!t.defined() || t.dim() == 0 || t.size(0) != n)
+    fail("densification statistics: {} does not have {} rows", name, n);
+}
+
+// (M, 3, 3) rotation matrices of (M, 4) quaternions w x y z, normalized first.
+Tensor rotation_matrices(const Tensor& quats) {
+  const Tensor q = quats / quats.norm(2, 1, true);
+  const Tensor w = q.select(1, 0), x = q.select(1, 1), y = q.select(1, 2), z = q.select(1, 3);
+  return torch::stack({1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                       2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                       2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
+                      1)
+      .view({-1, 3, 3});
+}
+
+Tensor max_scale(const GaussianModel& model) {
+  return std::get<0>(model.log_scales.detach().exp().max(1));
+}
+
+// New Gaussians to append, one tensor per parameter plus their 3D filter.
+struct NewRows {
+  std::array<Tensor, kParamCount> params;
+  Tensor filter_3d;
+};
+
+NewRows copies_of(const GaussianModel& model, const Tensor& mask) {
+  NewRows rows;
+  for (int p = 0; p < kParamCount; ++p)
+    rows.params[p] = model.param(Param(p)).detach().index({mask});
+  if (model.filter_3d.defined()) rows.filter_3d = model.filter_3d.index({mask});
+  return rows;
+}
+
+// Each masked Gaussian becomes two samples drawn from itself, with scales / 1.6.
+NewRows split_children(const GaussianModel& model, const Tensor& mask) {
+  NewRows parents = copies_of(model, mask);
+  NewRows rows;
+  for (int p = 0; p < kParamCount; ++p) {
+    std::vector<int64_t> repeats(parents.params[p].dim(), 1);
+    repeats[0] = kSplitSamples;
+    rows.params[p] = parents.params[p].repeat(repeats);
+  }
+  if (parents.filter_3d.defined()) rows.filter_3d = parents.filter_3d.repeat({kSplitSamples});
+  const Tensor scales = rows.params[int(Param::LogScales)].exp();
+  const Tensor offsets = torch::randn_like(scales) * scales;
+  const Tensor rotations = rotation_matrices(rows.params[int(Param::Quats)]);
+  rows.params[int(Param::Means)] += torch::bmm(rotations, offsets.unsqueeze(2)).squeeze(2);
+  rows.params[int(Param::LogScales)] = torch::log(scales / kSplitScaleDivisor);
+  return rows;
+}
+
+void append_rows(GaussianModel& model, GaussianOptimizer& optimizer, const NewRows& rows) {
+  const int64_t count = rows.params[0].size(0);
+  for (int p = 0; p < kParamCount; ++p)
+    model.set_param(Param(p), torch::cat({model.param(Param(p)).detach(), rows.params[p]}));
+  if (model.filter_3d.defined()) model.filter_3d = torch::cat({model.filter_3d, rows.filter_3d});
+  optimizer.append_rows(count);
+}
+
+void keep_rows(GaussianModel& model, GaussianOptimizer& optimizer, const Tensor& keep) {
+  for (int p = 0; p < kParamCount; ++p)
+    model.set_param(Param(p), model.param(Param(p)).detach().index({keep}));
+  if (model.filter_3d.defined()) model.filter_3d = model.filter_3d.index({keep}).contiguous();
+  optimizer.keep_rows(keep);
+}
+
+Tensor mean_gradient(const DensifyStats& stats, GradientSource source) {
+  const Tensor& sum = source == GradientSource::Absolute ? stats.abs_grad_sum : stats.grad_sum;
+  return torch::where(stats.count > 0, sum / stats.count.clamp_min(1), torch::zeros_like(sum));
+}
+
+Tensor prune_mask(const GaussianModel& model, const DensifyStats& stats,
+                  const DensifyOptions& options, double scene_extent) {
+  Tensor mask = torch::sigmoid(model.opacity_logits.detach()) < options.min_opacity;
+  if (options.max_screen_size > 0)
+    mask = mask | (stats.max_radii > options.max_screen_size) |
+           (max_scale(model) > 0.1 * scene_extent);
+  return mask;
+}
+
+}  // namespace
+
+DensifyStats DensifyStats::zeros(int64_t n) {
+  return {torch::zeros({n}), torch::zeros({n}), torch::zeros({n}), torch::zeros({n})};
+}
+
+void DensifyStats::accumulate(const std::vector<ViewStatistics>& views) {
+  const int64_t n = count.size(0);
+  for (const ViewStatistics& view : views) {
+    check_rows(view.radii, n, "radii");
+    check_rows(view.viewspace_grad, n, "viewspace gradient");
+    const Tensor visible = (view.radii > 0).to(torch::kFloat32);
+    grad_sum += view.viewspace_grad.norm(2, 1) * visible;
+    if (view.viewspace_abs_grad.defined()) {
+      check_rows(view.viewspace_abs_grad, n, "absolute viewspace gradient");
+      abs_grad_sum += view.viewspace_abs_grad.norm(2, 1) * visible;
+    }
+    count += visible;
+    max_radii = torch::maximum(max_radii, view.radii.to(torch::kFloat32) * visible);
+  }
+}
+
+void DensifyStats::save(torch::serialize::OutputArchive& archive) const {
+  archive.write("densify/grad_sum", grad_sum);
+  archive.write("densify/abs_grad_sum", abs_grad_sum);
+  archive.write("densify/count", count);
+  archive.write("densify/max_radii", max_radii);
+}
+
+void DensifyStats::load(torch::serialize::InputArchive& archive, int64_t n) {
+  DensifyStats loaded;
+  archive.read("densify/grad_sum", loaded.grad_sum);
+  archive.read("densify/abs_grad_sum", loaded.abs_grad_sum);
+  archive.read("densify/count", loaded.count);
+  archive.read("densify/max_radii", loaded.max_radii);
+  for (const Tensor* t : {&loaded.grad_sum, &loaded.abs_grad_sum, &loaded.count, &loaded.max_radii})
+    if (t->sizes() != c10::IntArrayRef{n} || t->scalar_type() != torch::kFloat32)
+      fail("densification statistics: stored accumulators do not have {} rows", n);
+  *this = loaded;
+}
+
+DensifyCounts densify_and_prune(GaussianModel& model, GaussianOptimizer& optimizer,
+                                DensifyStats& stats, const DensifyOptions& options,
+                                double scene_extent) {
+  torch::NoGradGuard no_grad;
+  const int64_t n = model.size();
+  const Tensor selected = mean_gradient(stats, options.source) >= options.grad_threshold;
+  const Tensor large = max_scale(model) > options.percent_dense * scene_extent;
+  const Tensor clone = selected & ~large, split = selected & large;
+  DensifyCounts counts{clone.sum().item<int64_t>(), split.sum().item<int64_t>(), 0};
+
+  // Rows as 3DGS orders them: originals, their clones, then the split children; split parents go.
+  const NewRows clones = copies_of(model, clone);
+  const NewRows children = split_children(model, split);
+  append_rows(model, optimizer, clones);
+  append_rows(model, optimizer, children);
+  const int64_t added = model.size() - n;
+  stats.max_radii = torch::cat({stats.max_radii, torch::zeros({added})});  // unseen yet
+  const Tensor parent_gone =
+      torch::cat({split, torch::zeros({added}, torch::TensorOptions().dtype(torch::kBool))});
+
+  const Tensor keep = ~(parent_gone | prune_mask(model, stats, options, scene_extent));
+  counts.pruned = model.size() - keep.sum().item<int64_t>() - counts.split;
+  keep_rows(model, optimizer, keep);
+  stats = DensifyStats::zeros(model.size());
+  return counts;
+}
+
+void reset_opacity(GaussianModel& model, GaussianOptimizer& optimizer) {
+  torch::NoGradGuard no_grad;
+  const Tensor opacity = torch::sigmoid(model.opacity_logits.detach());
+  Tensor filter_gain = torch::ones_like(opacity);
+  if (model.filter_3d.defined()) {
+    const Tensor s2 = model.log_scales.detach().exp().square();
+    const Tensor f2 = model.filter_3d.square().unsqueeze(1);
+    filter_gain = torch::sqrt(s2.prod(1) / (s2 + f2).prod(1));
+  }
+  const Tensor capped = torch::clamp_max(opacity * filter_gain, 0.01) / filter_gain;
+  model.set_param(Param::OpacityLogits, torch::log(capped / (1 - capped)));
+  optimizer.reset_moments(Param::OpacityLogits);
+}
+
+}  // namespace iesrgs::gs

@@ -1,0 +1,63 @@
+#pragma once
+// Adaptive density control of 3DGS / Mip-Splatting: screen-space gradient statistics gathered
+// from every rendered view, then clone, split and prune, and the periodic opacity reset. The
+// model's rows and the optimizer's moments always change together.
+#include <torch/serialize/archive.h>
+#include <torch/types.h>
+
+#include <vector>
+
+#include "gs/model.hpp"
+#include "gs/optimizer.hpp"
+
+namespace iesrgs::gs {
+
+// What one rendered view reports per Gaussian: the .grad() of its viewspace probes ((N, 2)
+// each) and its radii ((N) int32, 0 where not drawn).
+struct ViewStatistics {
+  torch::Tensor viewspace_grad;
+  torch::Tensor viewspace_abs_grad;
+  torch::Tensor radii;
+};
+
+enum class GradientSource { Viewspace, Absolute };
+
+struct DensifyOptions {
+  double grad_threshold = 2e-4;
+  GradientSource source = GradientSource::Viewspace;  // Absolute: GOF-style absolute gradients
+  double percent_dense = 0.01;  // clone below, split above this fraction of the extent
+  double min_opacity = 0.005;
+  float max_screen_size = 0;  // pixels; 0 disables the screen- and world-size pruning
+};
+
+// Per-Gaussian accumulators between two densification steps, as 3DGS's xyz_gradient_accum,
+// denom and max_radii2D (all (N) float).
+struct DensifyStats {
+  torch::Tensor grad_sum, abs_grad_sum, count, max_radii;
+
+  static DensifyStats zeros(int64_t n);
+  // Adds each view's gradient norms where that view drew the Gaussian, so all K views of a
+  // multi-view iteration count.
+  void accumulate(const std::vector<ViewStatistics>& views);
+
+  void save(torch::serialize::OutputArchive& archive) const;
+  // Throws Error unless the stored accumulators hold `n` rows.
+  void load(torch::serialize::InputArchive& archive, int64_t n);
+};
+
+struct DensifyCounts {
+  int64_t cloned = 0, split = 0, pruned = 0;
+};
+
+// Clones small Gaussians and splits large ones whose mean gradient reaches the threshold, then
+// prunes transparent and (when enabled) oversized ones, then zeroes the stats. Split samples
+// come from torch's default generator. The reference zeroes the screen radii before its size
+// check, which disables it; here it uses the radii gathered since the last densification.
+DensifyCounts densify_and_prune(GaussianModel& model, GaussianOptimizer& optimizer,
+                                DensifyStats& stats, const DensifyOptions& options,
+                                double scene_extent);
+
+// Caps every opacity, seen through the 3D filter, at 0.01 and zeroes the opacity moments.
+void reset_opacity(GaussianModel& model, GaussianOptimizer& optimizer);
+
+}  // namespace iesrgs::gs

@@ -1,0 +1,163 @@
+#include "gs/model.hpp"
+
+#include <cmath>
+#include <random>
+
+#include "core/error.hpp"
+#include "gs/filter3d.hpp"
+#include "gs/neighbors.hpp"
+#include "gs/sh.hpp"
+
+namespace iesrgs::gs {
+
+namespace {
+
+constexpr float kShC0 = 0.28209479177387814f;  // degree-0 SH basis value
+constexpr int kRestCoefficients = kShCoefficients - 1;
+
+torch::Tensor tensor_of(const std::vector<float>& values, c10::IntArrayRef shape) {
+  return torch::from_blob(const_cast<float*>(values.data()), shape, torch::kFloat32).clone();
+}
+
+std::vector<float> values_of(const torch::Tensor& t) {
+  const torch::Tensor c = t.detach().contiguous();
+  return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+}
+
+GaussianModel model_from_positions_and_dc(const std::vector<float>& positions,
+                                          const std::vector<float>& sh_dc) {
+  const int64_t n = int64_t(positions.size() / 3);
+  const std::vector<float> dist2 = mean_knn_squared_distance(positions.data(), int(n));
+  const torch::Tensor scale_log =
+      torch::log(torch::sqrt(torch::clamp_min(tensor_of(dist2, {n}), 1e-7)));
+  const float opacity = 0.1f;
+  GaussianModel model;
+  model.set_params(
+      {tensor_of(positions, {n, 3}), tensor_of(sh_dc, {n, 1, 3}),
+       torch::zeros({n, kRestCoefficients, 3}), torch::full({n}, std::log(opacity / (1 - opacity))),
+       scale_log.unsqueeze(1).repeat({1, 3}), torch::tensor({1.f, 0.f, 0.f, 0.f}).repeat({n, 1})});
+  return model;
+}
+
+// Copies a (N, K - 1, 3) rest block into the first K - 1 rows of a zeroed (N, 15, 3) one.
+torch::Tensor padded_rest(const SplatCloud& cloud) {
+  const int64_t n = int64_t(cloud.size());
+  const int64_t rest = sh_count(cloud.sh_degree) - 1;
+  torch::Tensor out = torch::zeros({n, kRestCoefficients, 3});
+  if (rest > 0) out.narrow(1, 0, rest).copy_(tensor_of(cloud.sh_rest, {n, rest, 3}));
+  return out;
+}
+
+void check_cloud(const SplatCloud& cloud) {
+  const size_t n = cloud.size();
+  const bool consistent = cloud.sh_degree >= 0 && cloud.sh_degree <= kMaxShDegree &&
+                          cloud.positions.size() == 3 * n && cloud.sh_dc.size() == 3 * n &&
+                          cloud.sh_rest.size() == size_t(sh_count(cloud.sh_degree) - 1) * 3 * n &&
+                          cloud.opacity.size() == n && cloud.log_scales.size() == 3 * n &&
+                          cloud.rotations.size() == 4 * n &&
+                          (cloud.filter_3d.empty() || cloud.filter_3d.size() == n);
+  if (!consistent) fail("splat cloud: array sizes disagree with {} Gaussians", n);
+}
+
+}  // namespace
+
+torch::Tensor& GaussianModel::param(Param p) {
+  return const_cast<torch::Tensor&>(static_cast<const GaussianModel&>(*this).param(p));
+}
+
+const torch::Tensor& GaussianModel::param(Param p) const {
+  switch (p) {
+    case Param::Means:
+      return means;
+    case Param::ShDc:
+      return sh_dc;
+    case Param::ShRest:
+      return sh_rest;
+    case Param::OpacityLogits:
+      return opacity_logits;
+    case Param::LogScales:
+      return log_scales;
+    case Param::Quats:
+      return quats;
+  }
+  fail("unknown Gaussian parameter {}", int(p));
+}
+
+raster::GaussianTensors GaussianModel::render_tensors() const {
+  return {means,     log_scales,      quats, opacity_logits, torch::cat({sh_dc, sh_rest}, 1),
+          filter_3d, active_sh_degree};
+}
+
+void GaussianModel::set_param(Param p, const torch::Tensor& value) {
+  param(p) = value.detach().clone().contiguous().requires_grad_(true);
+}
+
+void GaussianModel::set_params(const std::array<torch::Tensor, kParamCount>& values) {
+  for (int p = 0; p < kParamCount; ++p) set_param(Param(p), values[p]);
+}
+
+GaussianModel model_from_points(const std::vector<float>& positions,
+                                const std::vector<float>& colors) {
+  if (positions.size() % 3 != 0 || colors.size() != positions.size())
+    fail("initial points: {} coordinates and {} color values", positions.size(), colors.size());
+  std::vector<float> dc(colors.size());
+  for (size_t i = 0; i < colors.size(); ++i) dc[i] = (colors[i] - 0.5f) / kShC0;
+  return model_from_positions_and_dc(positions, dc);
+}
+
+GaussianModel model_from_point_cloud(const PointCloud& cloud) {
+  if (cloud.colors.size() != cloud.positions.size())
+    fail("SfM points: {} positions but {} colors", cloud.positions.size(), cloud.colors.size());
+  std::vector<float> positions, colors;
+  positions.reserve(3 * cloud.positions.size());
+  colors.reserve(3 * cloud.positions.size());
+  for (size_t i = 0; i < cloud.positions.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      positions.push_back(float(cloud.positions[i][a]));
+      colors.push_back(cloud.colors[i][a] / 255.f);
+    }
+  return model_from_points(positions, colors);
+}
+
+GaussianModel model_from_random_box(int count, float half_extent, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  std::vector<float> positions(3 * size_t(count)), dc(3 * size_t(count));
+  for (float& p : positions) p = (2 * unit(rng) - 1) * half_extent;
+  for (float& c : dc) c = unit(rng) / 255.f;
+  return model_from_positions_and_dc(positions, dc);
+}
+
+void update_filter_3d(GaussianModel& model, const std::vector<Camera>& cameras) {
+  const torch::Tensor means = model.means.detach().contiguous();
+  const std::vector<float> std_dev =
+      filter3d_std(means.data_ptr<float>(), int(model.size()), cameras);
+  model.filter_3d = tensor_of(std_dev, {model.size()});
+}
+
+SplatCloud to_splat_cloud(const GaussianModel& model) {
+  SplatCloud cloud;
+  cloud.sh_degree = kMaxShDegree;
+  cloud.positions = values_of(model.means);
+  cloud.sh_dc = values_of(model.sh_dc);
+  cloud.sh_rest = values_of(model.sh_rest);
+  cloud.opacity = values_of(model.opacity_logits);
+  cloud.log_scales = values_of(model.log_scales);
+  cloud.rotations = values_of(model.quats);
+  if (model.filter_3d.defined()) cloud.filter_3d = values_of(model.filter_3d);
+  return cloud;
+}
+
+GaussianModel model_from_splat_cloud(const SplatCloud& cloud) {
+  check_cloud(cloud);
+  const int64_t n = int64_t(cloud.size());
+  GaussianModel model;
+  model.set_params({tensor_of(cloud.positions, {n, 3}), tensor_of(cloud.sh_dc, {n, 1, 3}),
+                    padded_rest(cloud), tensor_of(cloud.opacity, {n}),
+                    tensor_of(cloud.log_scales, {n, 3}), tensor_of(cloud.rotations, {n, 4})});
+  if (cloud.has_filter_3d()) model.filter_3d = tensor_of(cloud.filter_3d, {n});
+  model.active_sh_degree = cloud.sh_degree;
+  return model;
+}
+
+}  // namespace iesrgs::gs

@@ -1,0 +1,177 @@
+#include "gs/densify.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace iesrgs::gs {
+namespace {
+
+using torch::Tensor;
+
+constexpr double kExtent = 10;  // clone below max scale 0.1, split above; world prune above 1
+
+// Gaussian i has mean (i, 0, 0), isotropic scale scales[i], opacity opacities[i], and SH and
+// rotation values that identify it.
+GaussianModel tiny_model(const std::vector<float>& scales, const std::vector<float>& opacities) {
+  const int64_t n = int64_t(scales.size());
+  const Tensor index = torch::arange(n, torch::kFloat32);
+  const Tensor opacity = torch::tensor(opacities);
+  GaussianModel m;
+  m.set_params(
+      {torch::stack({index, torch::zeros({n}), torch::zeros({n})}, 1),
+       index.view({n, 1, 1}).expand({n, 1, 3}) + 0.5,
+       index.view({n, 1, 1}).expand({n, 15, 3}) - 0.5, torch::log(opacity / (1 - opacity)),
+       torch::log(torch::tensor(scales)).unsqueeze(1).repeat({1, 3}),
+       torch::stack({torch::ones({n}), index * 0.1, torch::zeros({n}), torch::zeros({n})}, 1)});
+  m.filter_3d = index * 0.01;
+  return m;
+}
+
+ViewStatistics view(const std::vector<float>& grad_norms, const std::vector<int>& radii) {
+  const Tensor g = torch::tensor(grad_norms);
+  return {torch::stack({g * 0.6, g * 0.8}, 1), torch::stack({g, torch::zeros_like(g)}, 1),
+          torch::tensor(radii, torch::kInt32)};
+}
+
+// An optimizer whose moments are all non-zero, so that their movement with the rows shows; the
+// parameters are put back after its step.
+GaussianOptimizer stepped_optimizer(GaussianModel& m) {
+  std::array<Tensor, kParamCount> before;
+  for (int p = 0; p < kParamCount; ++p) {
+    before[p] = m.param(Param(p)).detach().clone();
+    m.param(Param(p)).mutable_grad() = torch::ones_like(before[p]);
+  }
+  GaussianOptimizer opt(m, {}, kExtent);
+  opt.step(m);
+  m.set_params(before);
+  return opt;
+}
+
+TEST(Densify, AccumulatesEveryViewWhereTheGaussianIsDrawn) {
+  DensifyStats stats = DensifyStats::zeros(3);
+  stats.accumulate({view({1, 2, 3}, {5, 0, 2}), view({10, 20, 30}, {0, 4, 7})});
+  EXPECT_TRUE(torch::allclose(stats.grad_sum, torch::tensor({1.f, 20.f, 33.f})));
+  EXPECT_TRUE(torch::allclose(stats.abs_grad_sum, torch::tensor({1.f, 20.f, 33.f})));
+  EXPECT_TRUE(torch::equal(stats.count, torch::tensor({1.f, 1.f, 2.f})));
+  EXPECT_TRUE(torch::equal(stats.max_radii, torch::tensor({5.f, 4.f, 7.f})));
+  EXPECT_THROW(stats.accumulate({view({1, 2}, {1, 1})}), Error);
+}
+
+TEST(Densify, ClonesSmallSplitsLargePrunesTransparent) {
+  torch::manual_seed(0);
+  // 0: small, high gradient -> clone; 1: large, high gradient -> split; 2: small, low gradient
+  // -> kept; 3: transparent -> pruned; 4: high gradient but only on average below threshold.
+  GaussianModel m =
+      tiny_model({0.05f, 0.5f, 0.05f, 0.05f, 0.05f}, {0.5f, 0.6f, 0.7f, 0.004f, 0.5f});
+  GaussianOptimizer opt = stepped_optimizer(m);
+  const Tensor dc_moment_of_2 = opt.moments(Param::ShDc).first[2].clone();
+  DensifyStats stats = DensifyStats::zeros(5);
+  stats.accumulate({view({3e-4f, 3e-4f, 1e-4f, 0, 3e-4f}, {1, 1, 1, 1, 1}),
+                    view({3e-4f, 2e-4f, 1e-4f, 0, 0}, {1, 1, 1, 1, 1})});
+  const DensifyCounts counts = densify_and_prune(m, opt, stats, DensifyOptions{}, kExtent);
+  EXPECT_EQ(counts.cloned, 1);
+  EXPECT_EQ(counts.split, 1);
+  EXPECT_EQ(counts.pruned, 1);
+
+  // Rows: originals 0, 2, 4, the clone of 0, then the two children of 1.
+  ASSERT_EQ(m.size(), 6);
+  EXPECT_TRUE(
+      torch::equal(m.means.select(1, 0).narrow(0, 0, 4), torch::tensor({0.f, 2.f, 4.f, 0.f})));
+  for (int p = 0; p < kParamCount; ++p)
+    EXPECT_TRUE(torch::equal(m.param(Param(p))[3], m.param(Param(p))[0])) << p;
+  for (int child : {4, 5}) {
+    EXPECT_NEAR(m.log_scales[child][0].item<float>(), std::log(0.5f / 1.6f), 1e-6);
+    EXPECT_TRUE(torch::equal(m.quats[child], torch::tensor({1.f, 0.1f, 0.f, 0.f})));
+    EXPECT_NEAR(m.opacity_logits[child].item<float>(), std::log(0.6f / 0.4f), 1e-6);
+    EXPECT_TRUE(torch::equal(m.sh_rest[child], torch::full({15, 3}, 0.5f)));
+    EXPECT_NEAR(m.filter_3d[child].item<float>(), 0.01f, 1e-7);
+    const float offset = (m.means[child] - torch::tensor({1.f, 0.f, 0.f})).norm().item<float>();
+    EXPECT_GT(offset, 0.f);
+    EXPECT_LT(offset, 5 * 0.5f * std::sqrt(3.f));
+  }
+  EXPECT_FALSE(torch::equal(m.means[4], m.means[5]));
+
+  // Moments follow their rows; new rows start from zero.
+  EXPECT_TRUE(torch::equal(opt.moments(Param::ShDc).first[1], dc_moment_of_2));
+  for (int p = 0; p < kParamCount; ++p) {
+    const AdamMoments& mom = opt.moments(Param(p));
+    ASSERT_EQ(mom.first.size(0), 6);
+    EXPECT_GT(mom.second.narrow(0, 0, 3).abs().min().item<float>(), 0.f) << p;
+    EXPECT_EQ(mom.first.narrow(0, 3, 3).abs().max().item<float>(), 0.f) << p;
+    EXPECT_EQ(mom.second.narrow(0, 3, 3).abs().max().item<float>(), 0.f) << p;
+  }
+  EXPECT_EQ(stats.count.size(0), 6);
+  EXPECT_EQ(stats.grad_sum.abs().sum().item<float>(), 0.f);
+  EXPECT_TRUE(m.means.requires_grad());
+}
+
+TEST(Densify, SplitSamplesFollowTheRotatedShape) {
+  torch::manual_seed(1);
+  const int n = 4000;
+  GaussianModel m = tiny_model(std::vector<float>(n, 1.f), std::vector<float>(n, 0.5f));
+  m.set_param(Param::Means, torch::zeros({n, 3}));
+  m.set_param(Param::LogScales, torch::log(torch::tensor({1.f, 0.1f, 0.01f})).repeat({n, 1}));
+  // 90 degrees about z: the long local x axis becomes world y.
+  const float h = std::sqrt(0.5f);
+  m.set_param(Param::Quats, torch::tensor({h, 0.f, 0.f, h}).repeat({n, 1}));
+  GaussianOptimizer opt(m, {}, kExtent);
+  DensifyStats stats = DensifyStats::zeros(n);
+  stats.accumulate({view(std::vector<float>(n, 1.f), std::vector<int>(n, 1))});
+  densify_and_prune(m, opt, stats, DensifyOptions{}, kExtent);
+  ASSERT_EQ(m.size(), 2 * n);
+  const Tensor spread = m.means.std(0);
+  EXPECT_NEAR(spread[0].item<float>(), 0.1f, 0.01f);
+  EXPECT_NEAR(spread[1].item<float>(), 1.f, 0.05f);
+  EXPECT_NEAR(spread[2].item<float>(), 0.01f, 0.001f);
+}
+
+TEST(Densify, AbsoluteGradientsCanDriveDensification) {
+  GaussianModel m = tiny_model({0.05f}, {0.5f});
+  GaussianOptimizer opt(m, {}, kExtent);
+  DensifyStats stats = DensifyStats::zeros(1);
+  // Norm of the plain gradient 1.5e-4, of the absolute one 1.5e-4 / 0.6 = 2.5e-4.
+  stats.accumulate({view({1.5e-4f / 0.6f}, {1})});
+  stats.grad_sum = torch::tensor({1.5e-4f});
+  DensifyOptions options;
+  EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).cloned, 0);
+  stats.accumulate({view({2.5e-4f}, {1})});
+  options.source = GradientSource::Absolute;
+  EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).cloned, 1);
+}
+
+TEST(Densify, PrunesOversizedGaussiansOnlyWhenEnabled) {
+  // 0: fine; 1: 30 px on screen; 2: world scale 2 > 0.1 * extent (and large, low gradient).
+  GaussianModel m = tiny_model({0.05f, 0.05f, 2.f}, {0.5f, 0.5f, 0.5f});
+  GaussianOptimizer opt(m, {}, kExtent);
+  DensifyStats stats = DensifyStats::zeros(3);
+  stats.accumulate({view({0, 0, 0}, {5, 30, 5})});
+  DensifyOptions options;
+  EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).pruned, 0);
+  stats.accumulate({view({0, 0, 0}, {5, 30, 5})});
+  options.max_screen_size = 20;
+  EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).pruned, 2);
+  ASSERT_EQ(m.size(), 1);
+  EXPECT_EQ(m.means[0][0].item<float>(), 0.f);
+}
+
+TEST(Densify, OpacityResetCapsEffectiveOpacityAndZeroesItsMoments) {
+  GaussianModel m = tiny_model({0.05f, 0.05f, 0.05f}, {0.5f, 0.005f, 0.5f});
+  m.filter_3d =
+      torch::tensor({0.f, 0.f, 0.05f});  // halves the volume ratio per axis: gain 1/(2 sqrt 2)
+  GaussianOptimizer opt = stepped_optimizer(m);
+  reset_opacity(m, opt);
+  const Tensor opacity = torch::sigmoid(m.opacity_logits);
+  EXPECT_NEAR(opacity[0].item<float>(), 0.01f, 1e-7);
+  EXPECT_NEAR(opacity[1].item<float>(), 0.005f, 1e-7);
+  EXPECT_NEAR(opacity[2].item<float>() / (2 * std::sqrt(2.f)), 0.01f, 1e-7);
+  EXPECT_EQ(opt.moments(Param::OpacityLogits).first.abs().sum().item<float>(), 0.f);
+  EXPECT_EQ(opt.moments(Param::OpacityLogits).second.abs().sum().item<float>(), 0.f);
+  EXPECT_GT(opt.moments(Param::Means).first.abs().sum().item<float>(), 0.f);
+  EXPECT_TRUE(m.opacity_logits.requires_grad());
+}
+
+}  // namespace
+}  // namespace iesrgs::gs
