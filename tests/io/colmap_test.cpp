@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/colmap.hpp"
+#include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs {
@@ -102,15 +103,10 @@ void expect_same(const ColmapModel& a, const ColmapModel& b) {
 // Runs `action`, which must throw Error, and checks the message holds every one of `parts`.
 template <typename Action>
 void expect_error(Action&& action, std::initializer_list<std::string> parts) {
-  try {
-    action();
-    ADD_FAILURE() << "no Error thrown";
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    for (const std::string& part : parts)
-      EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-  }
+  const std::string message = testing::error_message(std::forward<Action>(action));
+  for (const std::string& part : parts)
+    EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
 }
 
 // Little-endian bytes spelled out field by field, independently of the code under test.
