@@ -56,16 +56,19 @@ GaussianModel load_model(torch::serialize::InputArchive& archive) {
 }  // namespace
 
 void save_training_state(const std::filesystem::path& path, const GaussianModel& model,
-                         const GaussianOptimizer& optimizer, const DensifyStats& stats) {
+                         const GaussianOptimizer& optimizer, const DensifyStats& stats,
+                         const CheckpointExtras& extras) {
   torch::serialize::OutputArchive archive;
   save_model(archive, model);
   optimizer.save_state(archive);
   stats.save(archive);
+  for (const auto& [name, value] : extras) archive.write("extra/" + name, value);
   write_atomically(path, [&](const std::filesystem::path& tmp) { archive.save_to(tmp.string()); });
 }
 
 void load_training_state(const std::filesystem::path& path, GaussianModel& model,
-                         GaussianOptimizer& optimizer, DensifyStats& stats) {
+                         GaussianOptimizer& optimizer, DensifyStats& stats,
+                         CheckpointExtras* extras) {
   try {
     torch::serialize::InputArchive archive;
     archive.load_from(path.string());
@@ -74,6 +77,8 @@ void load_training_state(const std::filesystem::path& path, GaussianModel& model
     loaded_optimizer.load_state(archive, loaded_model);
     DensifyStats loaded_stats;
     loaded_stats.load(archive, loaded_model.size());
+    if (extras)
+      for (auto& [name, value] : *extras) archive.read("extra/" + name, value);
     model = std::move(loaded_model);
     optimizer = std::move(loaded_optimizer);
     stats = std::move(loaded_stats);
