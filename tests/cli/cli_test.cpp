@@ -1,46 +1,22 @@
 // End-to-end checks of the iesrgs binary: exit codes and one-line errors as a user sees them.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <string>
 
 #include "io/atomic_file.hpp"
+#include "support/cli_run.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs {
 namespace {
 
+using testing::CliRun;
+using testing::contains;
+using testing::iesrgs;
+using testing::last_line;
 using testing::TempDir;
 using testing::write_text;
-
-struct CliRun {
-  int status = -1;
-  std::string output;  // stdout and stderr together
-};
-
-CliRun iesrgs(const std::string& args) {
-  CliRun run;
-  const std::string command = std::string(IESRGS_CLI_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return run;
-  char buffer[4096];
-  while (size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) run.output.append(buffer, n);
-  const int status = ::pclose(pipe);
-  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
-// The last line of the output: where the CLI puts its one-line error.
-std::string last_line(const std::string& output) {
-  std::string text = output;
-  while (!text.empty() && text.back() == '\n') text.pop_back();
-  return text.substr(text.find_last_of('\n') + 1);
-}
 
 TEST(Cli, InfoHelpExplainsTheOptions) {
   const CliRun run = iesrgs("info --help");

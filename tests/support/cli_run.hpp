@@ -1,0 +1,20 @@
+#pragma once
+// Runs the built iesrgs binary as a user would, for end-to-end tests of the CLI.
+#include <string>
+
+namespace iesrgs::testing {
+
+struct CliRun {
+  int status = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// `args` is appended to the binary's path and run by the shell.
+CliRun iesrgs(const std::string& args);
+
+bool contains(const std::string& text, const std::string& part);
+
+// The last line of the output: where the CLI puts its one-line error.
+std::string last_line(const std::string& output);
+
+}  // namespace iesrgs::testing
