@@ -1,0 +1,66 @@
+#pragma once
+// Every hyper-parameter of a training run, the presets that fill them in, and their JSON form
+// (the file saved beside the outputs, and the config files users pass in).
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gs/densify.hpp"
+#include "gs/optimizer.hpp"
+
+namespace iesrgs::train {
+
+struct TrainConfig {
+  std::string preset = "paper";
+  int64_t iterations = 30000;
+  int views_per_iteration = 1;  // MVGS's K: distinct random views summed into one step
+  uint64_t seed = 0;
+  double dssim_weight = 0.2;  // loss = (1 - w) * L1 + w * D-SSIM per view
+
+  int max_sh_degree = 3;
+  int64_t sh_increase_every = 1000;
+
+  int64_t densify_from = 500, densify_until = 15000, densify_every = 100;
+  int64_t opacity_reset_every = 3000;
+  double grad_threshold = 2e-4;
+  bool absolute_gradients = false;
+  double percent_dense = 0.01;
+  double min_opacity = 0.005;
+  float max_screen_size = 20;         // pixels, enforced after the first opacity reset
+  int64_t filter_update_every = 100;  // Mip-Splatting 3D filter, once densification has stopped
+
+  gs::LearningRates learning_rates;
+
+  std::string init = "auto";  // auto (SfM points when the scene has some, else random), random
+  int random_points = 100000;
+  float random_extent = 1.3f;
+
+  int64_t checkpoint_every = 1000;
+  int64_t test_every = 1000;  // iterations between test PSNR reports; 0 = never
+  int test_views = 10;        // test views in those reports (evenly spaced); 0 = all
+  int64_t log_every = 10;
+};
+
+// Names of the built-in presets: "paper" (METHOD.md's 30k-iteration schedule, for GPUs) and the
+// CPU ones, which keep the algorithm and shorten the schedule.
+std::vector<std::string> preset_names();
+
+// The preset, with its schedule (densification window, opacity reset, SH steps, position decay)
+// rescaled to `iterations` when that is positive. Throws Error for an unknown name.
+TrainConfig make_preset(const std::string& name, int64_t iterations = 0);
+
+// Rescales every iteration count of the schedule so that it spans `iterations`.
+void rescale_schedule(TrainConfig& config, int64_t iterations);
+
+nlohmann::json to_json(const TrainConfig& config);
+// Overrides the fields present in `json`; unknown keys and wrong types are errors naming `origin`.
+void apply_json(TrainConfig& config, const nlohmann::json& json, const std::string& origin);
+// "key=value" overrides from the command line (value parsed as JSON, else taken as a string).
+void apply_assignment(TrainConfig& config, const std::string& assignment);
+
+// Throws Error naming the first inconsistent field.
+void validate(const TrainConfig& config);
+
+}  // namespace iesrgs::train

@@ -1,0 +1,66 @@
+#include "train/progress.hpp"
+
+#include <fmt/core.h>
+
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace iesrgs::train {
+
+namespace {
+constexpr double kPrintSeconds = 2.0;
+constexpr double kLossSmoothing = 0.9;  // exponential moving average, as 3DGS's progress bar
+}  // namespace
+
+ProgressLog::ProgressLog(const std::filesystem::path& csv, int64_t first_iteration,
+                         int64_t total_iterations)
+    : first_iteration_(first_iteration),
+      total_iterations_(total_iterations),
+      start_(Clock::now()),
+      last_print_(start_),
+      last_print_iteration_(first_iteration) {
+  const bool fresh = !std::filesystem::exists(csv);
+  if (!csv.parent_path().empty()) std::filesystem::create_directories(csv.parent_path());
+  csv_.open(csv, std::ios::app);
+  if (!csv_) fail_file(csv, "cannot be opened for writing");
+  if (fresh) csv_ << "iteration,loss,gaussians,elapsed_seconds,test_psnr\n";
+}
+
+void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
+                         std::optional<double> test_psnr, bool force) {
+  smoothed_loss_ = iteration == first_iteration_ + 1
+                       ? loss
+                       : kLossSmoothing * smoothed_loss_ + (1 - kLossSmoothing) * loss;
+  const Clock::time_point now = Clock::now();
+  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  csv_ << iteration << ',' << loss << ',' << gaussians << ',' << elapsed << ',';
+  if (test_psnr) csv_ << *test_psnr;
+  csv_ << '\n';
+  const double since_print = std::chrono::duration<double>(now - last_print_).count();
+  if (!force && !test_psnr && since_print < kPrintSeconds) return;
+  csv_.flush();
+  const double rate = since_print > 0 ? double(iteration - last_print_iteration_) / since_print : 0;
+  const double overall = elapsed > 0 ? double(iteration - first_iteration_) / elapsed : 0;
+  const double eta = overall > 0 ? double(total_iterations_ - iteration) / overall : 0;
+  std::string line = fmt::format(
+      "[{:>{}}/{}] {:5.1f}% | {:6.2f} it/s | loss {:.4f} | {:>8} Gaussians | elapsed {} | ETA {}",
+      iteration, std::to_string(total_iterations_).size(), total_iterations_,
+      100.0 * double(iteration) / double(total_iterations_), rate, smoothed_loss_, gaussians,
+      format_duration(elapsed), format_duration(eta));
+  if (test_psnr) line += fmt::format(" | test PSNR {:.2f} dB", *test_psnr);
+  fmt::print("{}\n", line);
+  std::fflush(stdout);
+  last_print_ = now;
+  last_print_iteration_ = iteration;
+}
+
+std::string format_duration(double seconds) {
+  const int64_t total = std::llround(std::max(0.0, seconds));
+  const int64_t h = total / 3600, m = total / 60 % 60, s = total % 60;
+  if (h > 0) return fmt::format("{}h{:02}m{:02}s", h, m, s);
+  if (m > 0) return fmt::format("{}m{:02}s", m, s);
+  return fmt::format("{}s", s);
+}
+
+}  // namespace iesrgs::train

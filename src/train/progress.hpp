@@ -1,0 +1,34 @@
+#pragma once
+// What a training run tells the person watching it (a line every couple of seconds: iteration,
+// it/s, loss, Gaussians, ETA, test PSNR when measured) and the CSV log kept beside the outputs.
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+
+namespace iesrgs::train {
+
+class ProgressLog {
+ public:
+  // Appends to `csv` (writing the header when the file is new): a resumed run continues its log.
+  ProgressLog(const std::filesystem::path& csv, int64_t first_iteration, int64_t total_iterations);
+
+  // Prints when `force`, when a test PSNR came in, or when enough time has passed.
+  void record(int64_t iteration, double loss, int64_t gaussians, std::optional<double> test_psnr,
+              bool force);
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  std::ofstream csv_;
+  int64_t first_iteration_, total_iterations_;
+  Clock::time_point start_, last_print_;
+  int64_t last_print_iteration_;
+  double smoothed_loss_ = 0;
+};
+
+// "1h02m05s", "3m07s", "42s".
+std::string format_duration(double seconds);
+
+}  // namespace iesrgs::train

@@ -1,0 +1,38 @@
+#include "train/session.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "core/error.hpp"
+#include "io/ply.hpp"
+
+namespace iesrgs::train {
+
+std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images) {
+  std::vector<TrainView> views;
+  for (const Camera* camera : scene.split(split))
+    views.push_back({*camera, to_chw_tensor(*images.rgb(*camera))});
+  return views;
+}
+
+gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
+                                const std::filesystem::path& init_ply) {
+  if (!init_ply.empty()) {
+    spdlog::info("starting from {}", init_ply.string());
+    return gs::model_from_splat_cloud(read_ply(init_ply));
+  }
+  if (config.init == "auto" && !scene.points.positions.empty()) {
+    spdlog::info("starting from {} SfM points", scene.points.positions.size());
+    return gs::model_from_point_cloud(scene.points);
+  }
+  spdlog::info("starting from {} random points in [-{}, {}]^3", config.random_points,
+               config.random_extent, config.random_extent);
+  return gs::model_from_random_box(config.random_points, config.random_extent, config.seed);
+}
+
+void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianModel& model) {
+  const SplatCloud cloud = gs::to_splat_cloud(model);
+  write_ply(dir / "point_cloud.ply", cloud);
+  write_ply_filter_baked(dir / "point_cloud_filter_baked.ply", cloud);
+}
+
+}  // namespace iesrgs::train

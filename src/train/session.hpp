@@ -1,0 +1,28 @@
+#pragma once
+// A scene on disk turned into what the trainer takes, and the trained model turned into the
+// standard outputs.
+#include <filesystem>
+#include <vector>
+
+#include "gs/model.hpp"
+#include "io/scene.hpp"
+#include "io/view_images.hpp"
+#include "train/config.hpp"
+#include "train/trainer.hpp"
+
+namespace iesrgs::train {
+
+// Every camera of `split` with its decoded image, in scene order.
+std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images);
+
+// The starting model: `init_ply` when given, else SfM points when the scene has them and the
+// config allows, else config.random_points in a box of half-size config.random_extent.
+gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
+                                const std::filesystem::path& init_ply);
+
+// <dir>/point_cloud.ply (3DGS layout plus the Mip-Splatting filter_3D property) and
+// <dir>/point_cloud_filter_baked.ply (the filter folded into scale and opacity, for viewers that
+// do not know it), both written atomically.
+void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianModel& model);
+
+}  // namespace iesrgs::train

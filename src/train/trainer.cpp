@@ -1,0 +1,270 @@
+#include "train/trainer.hpp"
+
+#include <fmt/core.h>
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "gs/checkpoint.hpp"
+#include "gs/densify.hpp"
+#include "loss/autograd.hpp"
+#include "raster/rasterizer.hpp"
+#include "train/progress.hpp"
+
+namespace iesrgs::train {
+
+namespace {
+
+std::atomic<bool> interrupt_requested{false};
+
+extern "C" void request_interrupt(int) {
+  interrupt_requested = true;
+  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C stops at once
+}
+
+// SIGINT asks the loop to checkpoint and return, only while a run is in progress.
+class InterruptScope {
+ public:
+  InterruptScope() {
+    interrupt_requested = false;
+    previous_ = std::signal(SIGINT, request_interrupt);
+  }
+  ~InterruptScope() { std::signal(SIGINT, previous_); }
+
+ private:
+  void (*previous_)(int);
+};
+
+torch::Tensor photometric_loss(const torch::Tensor& image, const torch::Tensor& target,
+                               double dssim_weight) {
+  const torch::Tensor l1 = (image - target).abs().mean();
+  const torch::Tensor ssim = loss::ssim_autograd(image, target).mean;
+  return (1 - dssim_weight) * l1 + dssim_weight * (1 - ssim);
+}
+
+torch::Tensor bytes_tensor(const std::string& bytes) {
+  return torch::from_blob(const_cast<char*>(bytes.data()), {int64_t(bytes.size())}, torch::kUInt8)
+      .clone();
+}
+
+std::string tensor_bytes(const torch::Tensor& tensor) {
+  const torch::Tensor bytes = tensor.to(torch::kUInt8).contiguous();
+  return std::string(reinterpret_cast<const char*>(bytes.data_ptr<uint8_t>()), bytes.numel());
+}
+
+double psnr(const torch::Tensor& image, const torch::Tensor& target) {
+  const double mse = (image.clamp(0, 1) - target).square().mean().item<double>();
+  return -10.0 * std::log10(std::max(mse, 1e-20));
+}
+
+bool all_finite(const gs::GaussianModel& model) {
+  for (int p = 0; p < gs::kParamCount; ++p)
+    if (!torch::isfinite(model.param(gs::Param(p))).all().item<bool>()) return false;
+  return true;
+}
+
+}  // namespace
+
+torch::Tensor to_chw_tensor(const Image& image) {
+  if (image.channels != 3) fail("expected an RGB image, got {} channels", image.channels);
+  return torch::from_blob(const_cast<float*>(image.data.data()), {image.height, image.width, 3},
+                          torch::kFloat32)
+      .permute({2, 0, 1})
+      .contiguous();
+}
+
+Trainer::Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianModel initial)
+    : config_(config), setup_(std::move(setup)), model_(std::move(initial)) {
+  validate(config_);
+  if (setup_.train_views.empty()) fail("training needs at least one view");
+  for (const TrainView& view : setup_.train_views) train_cameras_.push_back(view.camera);
+  torch::manual_seed(config_.seed);
+  view_rng_.seed(config_.seed);
+  model_.active_sh_degree = std::min(model_.active_sh_degree, config_.max_sh_degree);
+  if (!model_.filter_3d.defined()) gs::update_filter_3d(model_, train_cameras_);
+  optimizer_.emplace(model_, config_.learning_rates, setup_.scene_extent);
+  stats_ = gs::DensifyStats::zeros(model_.size());
+}
+
+std::filesystem::path Trainer::checkpoint_path() const {
+  return setup_.output_dir / "checkpoint.pt";
+}
+
+void Trainer::save_checkpoint() {
+  if (!all_finite(model_)) return;  // never replace a good checkpoint with a broken model
+  std::ostringstream view_rng;
+  view_rng << view_rng_;
+  torch::Tensor torch_rng;
+  {
+    auto generator = at::detail::getDefaultCPUGenerator();
+    std::lock_guard<std::mutex> lock(generator.mutex());
+    torch_rng = generator.get_state();
+  }
+  gs::save_training_state(checkpoint_path(), model_, *optimizer_, stats_,
+                          {{"iteration", torch::tensor(iteration_)},
+                           {"view_rng", bytes_tensor(view_rng.str())},
+                           {"torch_rng", torch_rng}});
+  checkpoint_iteration_ = iteration_;
+}
+
+void Trainer::resume() {
+  const std::filesystem::path path = checkpoint_path();
+  if (!std::filesystem::exists(path))
+    fail_file(path, "no checkpoint to resume from (train without --resume first)");
+  gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}}};
+  gs::load_training_state(path, model_, *optimizer_, stats_, &extras);
+  iteration_ = extras["iteration"].item<int64_t>();
+  std::istringstream view_rng(tensor_bytes(extras["view_rng"]));
+  view_rng >> view_rng_;
+  if (!view_rng) fail_file(path, "the stored view sampler state is corrupt");
+  auto generator = at::detail::getDefaultCPUGenerator();
+  std::lock_guard<std::mutex> lock(generator.mutex());
+  generator.set_state(extras["torch_rng"]);
+  checkpoint_iteration_ = iteration_;
+}
+
+std::vector<int> Trainer::pick_views() {
+  std::vector<int> order(setup_.train_views.size());
+  std::iota(order.begin(), order.end(), 0);
+  const size_t count = std::min(order.size(), size_t(config_.views_per_iteration));
+  for (size_t i = 0; i < count; ++i) {  // partial Fisher-Yates: `count` distinct views
+    std::uniform_int_distribution<size_t> pick(i, order.size() - 1);
+    std::swap(order[i], order[pick(view_rng_)]);
+  }
+  order.resize(count);
+  return order;
+}
+
+double Trainer::step(int64_t iteration) {
+  if (iteration % config_.sh_increase_every == 0 && model_.active_sh_degree < config_.max_sh_degree)
+    ++model_.active_sh_degree;
+  std::vector<gs::ViewStatistics> view_stats;
+  double total = 0;
+  for (int v : pick_views()) {
+    const TrainView& view = setup_.train_views[size_t(v)];
+    raster::ViewspaceProbes probes{torch::zeros({model_.size(), 2}, torch::requires_grad()),
+                                   torch::zeros({model_.size(), 2}, torch::requires_grad())};
+    const raster::RenderOutput render =
+        raster::render(model_.render_tensors(), raster::raster_camera<float>(view.camera),
+                       setup_.background, probes);
+    const torch::Tensor loss =
+        setup_.loss ? setup_.loss(v, render)
+                    : photometric_loss(render.image, view.target, config_.dssim_weight);
+    // Backward per view: the gradient of the sum without holding K render graphs at once.
+    loss.backward();
+    total += loss.item<double>();
+    view_stats.push_back({probes.grad.grad(), probes.abs_grad.grad(), render.radii});
+  }
+  check_finite(iteration, total);
+  if (iteration < config_.densify_until) stats_.accumulate(view_stats);
+  optimizer_->step(model_);
+  for (int p = 0; p < gs::kParamCount; ++p)
+    model_.param(gs::Param(p)).mutable_grad() = torch::Tensor();
+  densify(iteration);
+  return total;
+}
+
+void Trainer::densify(int64_t iteration) {
+  const TrainConfig& c = config_;
+  if (iteration < c.densify_until) {
+    if (iteration > c.densify_from && iteration % c.densify_every == 0) {
+      gs::DensifyOptions options;
+      options.grad_threshold = c.grad_threshold;
+      options.source =
+          c.absolute_gradients ? gs::GradientSource::Absolute : gs::GradientSource::Viewspace;
+      options.percent_dense = c.percent_dense;
+      options.min_opacity = c.min_opacity;
+      options.max_screen_size = iteration > c.opacity_reset_every ? c.max_screen_size : 0;
+      gs::densify_and_prune(model_, *optimizer_, stats_, options, setup_.scene_extent);
+      gs::update_filter_3d(model_, train_cameras_);
+    }
+    const bool white = setup_.background == std::array<float, 3>{1, 1, 1};
+    if (iteration % c.opacity_reset_every == 0 || (white && iteration == c.densify_from))
+      gs::reset_opacity(model_, *optimizer_);
+  } else if (iteration % c.filter_update_every == 0 && iteration < c.iterations - 100) {
+    // As Mip-Splatting: keep the filter current, but not in the last steps.
+    gs::update_filter_3d(model_, train_cameras_);
+  }
+}
+
+void Trainer::check_finite(int64_t iteration, double loss) const {
+  const bool params_checked = iteration % 100 == 0;
+  if (std::isfinite(loss) && (!params_checked || all_finite(model_))) return;
+  const std::string kept =
+      checkpoint_iteration_ >= 0
+          ? fmt::format("the last good checkpoint (iteration {}) is kept in {}",
+                        checkpoint_iteration_, checkpoint_path().string())
+          : std::string("no checkpoint was written yet");
+  fail(
+      "training diverged at iteration {}: the {} stopped being finite (loss {}); {}. Lower the "
+      "learning rates or check the input images.",
+      iteration, std::isfinite(loss) ? "parameters" : "loss", loss, kept);
+}
+
+double Trainer::evaluate_psnr(const std::vector<TrainView>& views) const {
+  torch::NoGradGuard no_grad;
+  double sum = 0;
+  for (const TrainView& view : views) {
+    const raster::RenderOutput render = raster::render(
+        model_.render_tensors(), raster::raster_camera<float>(view.camera), setup_.background);
+    sum += psnr(render.image, view.target);
+  }
+  return views.empty() ? 0 : sum / double(views.size());
+}
+
+double Trainer::report_test_psnr() {
+  const std::vector<TrainView>& all = setup_.test_views;
+  const size_t count =
+      config_.test_views == 0 ? all.size() : std::min(all.size(), size_t(config_.test_views));
+  std::vector<TrainView> subset;
+  for (size_t i = 0; i < count; ++i) subset.push_back(all[i * all.size() / count]);
+  return evaluate_psnr(subset);
+}
+
+TrainSummary Trainer::run() {
+  InterruptScope interrupt_scope;
+  TrainSummary summary;
+  ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations);
+  const auto start = std::chrono::steady_clock::now();
+  const int64_t first = iteration_;
+  double loss = 0;
+  while (iteration_ < config_.iterations) {
+    loss = step(iteration_ + 1);
+    ++iteration_;
+    const bool last = iteration_ == config_.iterations;
+    std::optional<double> test_psnr;
+    if (!setup_.test_views.empty() && config_.test_every > 0 &&
+        (iteration_ % config_.test_every == 0 || last)) {
+      test_psnr = report_test_psnr();
+      summary.test_psnr = *test_psnr;
+    }
+    log.record(iteration_, loss, model_.size(), test_psnr, last);
+    const bool interrupted = interrupt_requested.load();
+    if (last || interrupted ||
+        (config_.checkpoint_every > 0 && iteration_ % config_.checkpoint_every == 0))
+      save_checkpoint();
+    if (interrupted) {
+      fmt::print("interrupted: checkpoint of iteration {} saved to {}; continue with --resume\n",
+                 iteration_, checkpoint_path().string());
+      summary.interrupted = true;
+      break;
+    }
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.iterations = iteration_;
+  summary.iterations_per_second =
+      summary.seconds > 0 ? double(iteration_ - first) / summary.seconds : 0;
+  summary.final_loss = loss;
+  summary.gaussians = model_.size();
+  return summary;
+}
+
+}  // namespace iesrgs::train

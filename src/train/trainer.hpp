@@ -1,0 +1,91 @@
+#pragma once
+// The Gaussian-splatting training loop every stage uses: Mip-Splatting (3D filter, 2D mip
+// filter) with 3DGS's densification and schedules, and MVGS's multi-view regulation (K distinct
+// views per iteration, losses summed, one optimizer step, densification statistics from all K).
+#include <torch/types.h>
+
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "gs/model.hpp"
+#include "io/camera.hpp"
+#include "io/image.hpp"
+#include "raster/autograd.hpp"
+#include "train/config.hpp"
+
+namespace iesrgs::train {
+
+// A camera the model is fitted to, with its reference image (3, H, W) in [0, 1].
+struct TrainView {
+  Camera camera;
+  torch::Tensor target;
+};
+
+// Loss of one rendered view; the default is (1 - w) * L1 + w * D-SSIM against the view's target.
+using ViewLoss = std::function<torch::Tensor(int view, const raster::RenderOutput& render)>;
+
+struct TrainerSetup {
+  std::vector<TrainView> train_views;
+  std::vector<TrainView> test_views;  // for the periodic PSNR report; may be empty
+  std::array<float, 3> background{1, 1, 1};
+  double scene_extent = 1;
+  std::filesystem::path output_dir;  // checkpoint.pt and train_log.csv go here
+  ViewLoss loss;                     // empty: the photometric default
+};
+
+struct TrainSummary {
+  int64_t iterations = 0;    // completed in total (including before a resume)
+  bool interrupted = false;  // stopped by SIGINT after saving a checkpoint
+  double seconds = 0;        // of this process's training
+  double iterations_per_second = 0;
+  double final_loss = 0;
+  double test_psnr = 0;  // last report; 0 without test views
+  int64_t gaussians = 0;
+};
+
+class Trainer {
+ public:
+  Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianModel initial);
+
+  // Continues from <output_dir>/checkpoint.pt exactly as if the run had never stopped. Throws
+  // Error naming the file when it is missing or unreadable.
+  void resume();
+
+  // Trains to config.iterations, printing progress; checkpoints every config.checkpoint_every
+  // iterations and when SIGINT arrives (then returns with summary.interrupted). Throws Error when
+  // the loss or the parameters stop being finite; the last good checkpoint stays on disk.
+  TrainSummary run();
+
+  const gs::GaussianModel& model() const { return model_; }
+  std::filesystem::path checkpoint_path() const;
+
+  // Mean PSNR of the model on `views` (all of them).
+  double evaluate_psnr(const std::vector<TrainView>& views) const;
+
+ private:
+  double step(int64_t iteration);  // returns the loss
+  std::vector<int> pick_views();
+  void densify(int64_t iteration);
+  void save_checkpoint();
+  void check_finite(int64_t iteration, double loss) const;
+  double report_test_psnr();
+
+  TrainConfig config_;
+  TrainerSetup setup_;
+  gs::GaussianModel model_;
+  std::optional<gs::GaussianOptimizer> optimizer_;
+  gs::DensifyStats stats_;
+  std::vector<Camera> train_cameras_;
+  std::mt19937_64 view_rng_;
+  int64_t iteration_ = 0;              // completed iterations
+  int64_t checkpoint_iteration_ = -1;  // of the last checkpoint written or read
+};
+
+// The cameras' image as a (3, H, W) float tensor, from the HWC images the loaders produce.
+torch::Tensor to_chw_tensor(const Image& image);
+
+}  // namespace iesrgs::train

@@ -1,0 +1,73 @@
+#include "train/config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "support/expect_error.hpp"
+
+namespace iesrgs::train {
+namespace {
+
+using testing::error_message;
+
+TEST(TrainConfig, PaperPresetIsMethodSchedule) {
+  const TrainConfig c = make_preset("paper");
+  EXPECT_EQ(c.iterations, 30000);
+  EXPECT_EQ(c.densify_from, 500);
+  EXPECT_EQ(c.densify_until, 15000);
+  EXPECT_EQ(c.densify_every, 100);
+  EXPECT_EQ(c.opacity_reset_every, 3000);
+  EXPECT_EQ(c.sh_increase_every, 1000);
+  EXPECT_DOUBLE_EQ(c.grad_threshold, 2e-4);
+  EXPECT_EQ(c.learning_rates.position_max_steps, 30000);
+}
+
+TEST(TrainConfig, ShorterRunsScaleTheScheduleTogether) {
+  const TrainConfig c = make_preset("paper", 6000);
+  EXPECT_EQ(c.iterations, 6000);
+  EXPECT_EQ(c.densify_from, 100);
+  EXPECT_EQ(c.densify_until, 3000);
+  EXPECT_EQ(c.opacity_reset_every, 600);
+  EXPECT_EQ(c.sh_increase_every, 200);
+  EXPECT_EQ(c.learning_rates.position_max_steps, 6000);
+  EXPECT_EQ(c.densify_every, 100);  // the rhythm of densification stays
+  EXPECT_EQ(make_preset("cpu").iterations, 10000);
+  EXPECT_EQ(make_preset("fast").iterations, 3000);
+}
+
+TEST(TrainConfig, JsonRoundTripsEveryField) {
+  TrainConfig c = make_preset("cpu", 1234);
+  c.views_per_iteration = 3;
+  c.absolute_gradients = true;
+  c.learning_rates.sh_dc = 0.125;
+  TrainConfig back;
+  apply_json(back, to_json(c), "test");
+  EXPECT_EQ(to_json(back), to_json(c));
+}
+
+TEST(TrainConfig, AssignmentsParseValues) {
+  TrainConfig c;
+  apply_assignment(c, "grad_threshold=0.0003");
+  apply_assignment(c, "absolute_gradients=true");
+  apply_assignment(c, "init=random");
+  EXPECT_DOUBLE_EQ(c.grad_threshold, 3e-4);
+  EXPECT_TRUE(c.absolute_gradients);
+  EXPECT_EQ(c.init, "random");
+}
+
+TEST(TrainConfig, BadInputNamesTheProblem) {
+  TrainConfig c;
+  EXPECT_NE(error_message([&] { apply_assignment(c, "grad_treshold=1"); }).find("grad_treshold"),
+            std::string::npos);
+  EXPECT_NE(error_message([&] { apply_assignment(c, "iterations=lots"); }).find("wrong type"),
+            std::string::npos);
+  EXPECT_NE(error_message([&] { apply_assignment(c, "novalue"); }).find("key=value"),
+            std::string::npos);
+  EXPECT_NE(error_message([] { make_preset("turbo"); }).find("turbo"), std::string::npos);
+  c.views_per_iteration = 0;
+  EXPECT_NE(error_message([&] { validate(c); }).find("views_per_iteration"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace iesrgs::train

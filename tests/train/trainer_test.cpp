@@ -1,0 +1,155 @@
+#include "train/trainer.hpp"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <csignal>
+#include <limits>
+
+#include "io/ply.hpp"
+#include "loss/autograd.hpp"
+#include "support/expect_error.hpp"
+#include "support/temp_dir.hpp"
+#include "synth/dataset_writer.hpp"
+#include "train/session.hpp"
+
+namespace iesrgs::train {
+namespace {
+
+using testing::error_message;
+using testing::TempDir;
+
+// A small synthetic scene shared by the tests: 10 train and 2 test views of 40x40.
+class TrainerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new TempDir;
+    synth::SynthOptions options;
+    options.size = 40;
+    options.train_views = 10;
+    options.test_views = 2;
+    options.seed = 5;
+    synth::write_synth_dataset(dir_->path() / "scene", options);
+  }
+  static void TearDownTestSuite() { delete dir_; }
+
+  TrainerSetup setup(const std::filesystem::path& out) const {
+    scene_ = load_scene(dir_->path() / "scene");
+    ViewImages images(scene_);
+    TrainerSetup s;
+    s.train_views = load_views(scene_, Split::Train, images);
+    s.test_views = load_views(scene_, Split::Test, images);
+    s.background = scene_.background;
+    s.scene_extent = scene_.normalization().radius;
+    s.output_dir = out;
+    return s;
+  }
+
+  static TrainConfig config() {
+    TrainConfig c = make_preset("fast", 40);
+    c.views_per_iteration = 3;
+    c.densify_every = 10;
+    c.checkpoint_every = 0;
+    c.test_every = 0;
+    c.random_points = 2000;
+    c.init = "random";
+    return c;
+  }
+
+  gs::GaussianModel initial() const { return initial_model(scene_, config(), {}); }
+
+  static TempDir* dir_;
+  mutable Scene scene_;
+};
+
+TempDir* TrainerTest::dir_ = nullptr;
+
+double max_difference(const gs::GaussianModel& a, const gs::GaussianModel& b) {
+  double largest = 0;
+  for (int p = 0; p < gs::kParamCount; ++p) {
+    const torch::Tensor& x = a.param(gs::Param(p));
+    const torch::Tensor& y = b.param(gs::Param(p));
+    if (x.sizes() != y.sizes()) return std::numeric_limits<double>::infinity();
+    largest = std::max(largest, (x - y).abs().max().item<double>());
+  }
+  return largest;
+}
+
+TEST_F(TrainerTest, FittingRaisesTestPsnrAndDensifies) {
+  TempDir out;
+  TrainerSetup s = setup(out.path());
+  const std::vector<TrainView> test = s.test_views;
+  Trainer trainer(config(), std::move(s), initial());
+  const double before = trainer.evaluate_psnr(test);
+  const int64_t start_size = trainer.model().size();
+  const TrainSummary summary = trainer.run();
+  EXPECT_EQ(summary.iterations, 40);
+  EXPECT_GT(trainer.evaluate_psnr(test), before + 3) << "before " << before;
+  EXPECT_NE(trainer.model().size(), start_size);
+  EXPECT_TRUE(std::filesystem::exists(trainer.checkpoint_path()));  // the last iteration's
+  EXPECT_TRUE(std::filesystem::exists(out / "train_log.csv"));
+}
+
+TEST_F(TrainerTest, InterruptedRunResumesToTheSameModel) {
+  TempDir straight_dir, resumed_dir;
+  Trainer straight(config(), setup(straight_dir.path()), initial());
+  straight.run();
+
+  // SIGINT in the middle of iteration 17: the loop checkpoints after it and returns.
+  TrainerSetup s = setup(resumed_dir.path());
+  int calls = 0;
+  const ViewLoss photometric = [&](int view, const raster::RenderOutput& render) {
+    if (++calls == 17 * 3) std::raise(SIGINT);
+    const torch::Tensor& target = s.train_views[size_t(view)].target;
+    return 0.8 * (render.image - target).abs().mean() +
+           0.2 * (1 - loss::ssim_autograd(render.image, target).mean);
+  };
+  TrainerSetup interrupted_setup = s;
+  interrupted_setup.loss = photometric;
+  Trainer first(config(), interrupted_setup, initial());
+  const TrainSummary partial = first.run();
+  ASSERT_TRUE(partial.interrupted);
+  EXPECT_EQ(partial.iterations, 17);
+
+  Trainer second(config(), s, initial());
+  second.resume();
+  EXPECT_EQ(second.run().iterations, 40);
+  EXPECT_EQ(max_difference(second.model(), straight.model()), 0.0);
+}
+
+TEST_F(TrainerTest, NonFiniteLossStopsWithTheCheckpointNamed) {
+  TempDir out;
+  TrainerSetup s = setup(out.path());
+  int calls = 0;
+  s.loss = [&](int, const raster::RenderOutput& render) {
+    ++calls;
+    const double poison = calls > 3 * 12 ? std::numeric_limits<double>::quiet_NaN() : 1.0;
+    return render.image.mean() * poison;
+  };
+  TrainConfig c = config();
+  c.checkpoint_every = 5;
+  Trainer trainer(c, std::move(s), initial());
+  const std::string message = error_message([&] { trainer.run(); });
+  EXPECT_NE(message.find("diverged at iteration 13"), std::string::npos) << message;
+  EXPECT_NE(message.find("iteration 10"), std::string::npos) << message;
+  EXPECT_NE(message.find("checkpoint.pt"), std::string::npos) << message;
+}
+
+TEST_F(TrainerTest, ResumeWithoutCheckpointIsAClearError) {
+  TempDir out;
+  Trainer trainer(config(), setup(out.path()), initial());
+  EXPECT_NE(error_message([&] { trainer.resume(); }).find("no checkpoint"), std::string::npos);
+}
+
+TEST_F(TrainerTest, PointCloudsRoundTripThroughPly) {
+  TempDir out;
+  Trainer trainer(config(), setup(out.path()), initial());
+  trainer.run();
+  write_point_clouds(out.path(), trainer.model());
+  const gs::GaussianModel back = gs::model_from_splat_cloud(read_ply(out / "point_cloud.ply"));
+  EXPECT_LT(max_difference(back, trainer.model()), 1e-6);
+  EXPECT_TRUE(std::filesystem::exists(out / "point_cloud_filter_baked.ply"));
+}
+
+}  // namespace
+}  // namespace iesrgs::train
