@@ -7,5 +7,8 @@ namespace iesrgs::cli {
 void add_synth_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_train_command(CLI::App& app);
+void add_render_command(CLI::App& app);
+void add_eval_command(CLI::App& app);
 
 }  // namespace iesrgs::cli

@@ -1,0 +1,124 @@
+// iesrgs train: fits a Mip-Splatting model to a scene's training views and writes the standard
+// 3DGS point cloud, the config used and a summary.
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.hpp"
+#include "cli/scene_options.hpp"
+#include "core/error.hpp"
+#include "core/memory.hpp"
+#include "io/atomic_file.hpp"
+#include "train/session.hpp"
+
+namespace iesrgs::cli {
+
+namespace {
+
+struct TrainArgs {
+  SceneArgs scene;
+  std::string output;
+  std::string preset = "cpu";
+  int64_t iterations = 0;
+  int views_per_iteration = 0;
+  int64_t seed = -1;
+  std::string config_file;
+  std::vector<std::string> assignments;
+  std::string init_ply;
+  bool resume = false;
+};
+
+nlohmann::json read_json_file(const std::filesystem::path& path) {
+  nlohmann::json json = nlohmann::json::parse(read_file(path), nullptr, false);
+  if (json.is_discarded()) fail_file(path, "is not valid JSON");
+  return json;
+}
+
+train::TrainConfig resolve_config(const TrainArgs& args, const std::filesystem::path& saved) {
+  train::TrainConfig config;
+  if (args.resume) {
+    // The stored config is the run's identity; changing it midway would not resume the run.
+    if (!std::filesystem::exists(saved))
+      fail_file(saved, "missing: --resume needs the output folder of an earlier run");
+    train::apply_json(config, read_json_file(saved), saved.string());
+    spdlog::info("resuming with the config saved in {}", saved.string());
+    return config;
+  }
+  config = train::make_preset(args.preset, args.iterations);
+  if (!args.config_file.empty())
+    train::apply_json(config, read_json_file(args.config_file), args.config_file);
+  if (args.views_per_iteration > 0) config.views_per_iteration = args.views_per_iteration;
+  if (args.seed >= 0) config.seed = uint64_t(args.seed);
+  for (const std::string& assignment : args.assignments)
+    train::apply_assignment(config, assignment);
+  train::validate(config);
+  return config;
+}
+
+void run_train(const TrainArgs& args) {
+  const std::filesystem::path out = args.output;
+  const train::TrainConfig config = resolve_config(args, out / "config.json");
+  if (!args.resume)
+    write_file_atomically(out / "config.json", train::to_json(config).dump(2) + "\n");
+
+  const Scene scene = load_scene(args.scene.path, args.scene.resolved());
+  ViewImages images(scene);
+  train::TrainerSetup setup;
+  setup.train_views = train::load_views(scene, Split::Train, images);
+  setup.test_views = train::load_views(scene, Split::Test, images);
+  setup.background = scene.background;
+  setup.scene_extent = scene.normalization().radius;
+  setup.output_dir = out;
+  const int width = setup.train_views.front().camera.intrinsics.width;
+  const int height = setup.train_views.front().camera.intrinsics.height;
+  fmt::print("training on {} views ({}x{}), {} test views; preset {}, {} iterations, K = {}\n",
+             setup.train_views.size(), width, height, setup.test_views.size(), config.preset,
+             config.iterations, config.views_per_iteration);
+
+  train::Trainer trainer(config, std::move(setup),
+                         train::initial_model(scene, config, args.init_ply));
+  if (args.resume) trainer.resume();
+  const train::TrainSummary summary = trainer.run();
+  if (summary.interrupted) return;
+  train::write_point_clouds(out, trainer.model());
+
+  const nlohmann::json report = {{"scene", scene.root.string()},
+                                 {"downscale", scene.downscale},
+                                 {"width", width},
+                                 {"height", height},
+                                 {"iterations", summary.iterations},
+                                 {"seconds", summary.seconds},
+                                 {"iterations_per_second", summary.iterations_per_second},
+                                 {"gaussians", summary.gaussians},
+                                 {"final_loss", summary.final_loss},
+                                 {"test_psnr", summary.test_psnr},
+                                 {"peak_memory_mib", double(peak_memory_bytes()) / (1 << 20)}};
+  write_file_atomically(out / "training.json", report.dump(2) + "\n");
+  fmt::print("done: {} Gaussians, {:.2f} it/s, test PSNR {:.2f} dB; wrote {}\n", summary.gaussians,
+             summary.iterations_per_second, summary.test_psnr, (out / "point_cloud.ply").string());
+}
+
+}  // namespace
+
+void add_train_command(CLI::App& app) {
+  auto args = std::make_shared<TrainArgs>();
+  CLI::App* command = app.add_subcommand("train", "Train a Gaussian-splatting model on a scene");
+  args->scene.add_to(*command);
+  command->add_option("-o,--output", args->output, "Output folder")->required();
+  command->add_option("--preset", args->preset, "Schedule: paper (30k, GPU), cpu (10k), fast (3k)")
+      ->capture_default_str();
+  command->add_option("--iterations", args->iterations,
+                      "Iterations; the preset's schedule is rescaled to fit");
+  command->add_option("--mv", args->views_per_iteration,
+                      "Views per iteration (multi-view regulation K; 1 = plain 3DGS)");
+  command->add_option("--seed", args->seed, "Random seed");
+  command->add_option("--config", args->config_file, "JSON file of training parameters");
+  command->add_option("--set", args->assignments,
+                      "Override one training parameter, key=value (repeatable; see config.json)");
+  command->add_option("--init-ply", args->init_ply, "Start from this 3DGS .ply instead");
+  command->add_flag("--resume", args->resume, "Continue the run in --output from its checkpoint");
+  command->callback([args] { run_train(*args); });
+}
+
+}  // namespace iesrgs::cli

@@ -1,0 +1,93 @@
+#include "eval/metrics.hpp"
+
+#include <fmt/core.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "loss/ssim.hpp"
+
+namespace iesrgs::eval {
+
+namespace {
+
+void check_pair(const Image& image, const Image& reference) {
+  if (image.channels != 3 || reference.channels != 3)
+    fail("metrics need RGB images, got {} and {} channels", image.channels, reference.channels);
+  if (image.width != reference.width || image.height != reference.height)
+    fail("image is {}x{} but its reference is {}x{}", image.width, image.height, reference.width,
+         reference.height);
+}
+
+std::vector<float> to_planar(const Image& image) {
+  const size_t pixels = size_t(image.width) * size_t(image.height);
+  std::vector<float> planar(pixels * 3);
+  for (size_t p = 0; p < pixels; ++p)
+    for (int c = 0; c < 3; ++c) planar[size_t(c) * pixels + p] = image.data[p * 3 + size_t(c)];
+  return planar;
+}
+
+nlohmann::json to_json(const ViewMetrics& m) {
+  nlohmann::json json = {{"name", m.name}, {"psnr", m.psnr}, {"ssim", m.ssim}};
+  json["lpips"] = m.lpips ? nlohmann::json(*m.lpips) : nlohmann::json(nullptr);
+  return json;
+}
+
+std::string csv_row(const ViewMetrics& m) {
+  return fmt::format("{},{:.6f},{:.6f},{}\n", m.name, m.psnr, m.ssim,
+                     m.lpips ? fmt::format("{:.6f}", *m.lpips) : "");
+}
+
+}  // namespace
+
+double psnr(const Image& image, const Image& reference) {
+  check_pair(image, reference);
+  double sum = 0;
+  for (size_t i = 0; i < image.data.size(); ++i) {
+    const double d = double(image.data[i]) - double(reference.data[i]);
+    sum += d * d;
+  }
+  const double mse = sum / double(image.data.size());
+  return mse > 0 ? -10.0 * std::log10(mse) : INFINITY;
+}
+
+double ssim(const Image& image, const Image& reference) {
+  check_pair(image, reference);
+  const std::vector<float> x = to_planar(image), y = to_planar(reference);
+  return loss::ssim<float>(x.data(), y.data(), {image.width, image.height, 3}, nullptr, nullptr);
+}
+
+ViewMetrics MetricsReport::mean() const {
+  ViewMetrics mean{"mean", 0, 0, 0.0};
+  for (const ViewMetrics& v : views) {
+    mean.psnr += v.psnr;
+    mean.ssim += v.ssim;
+    if (v.lpips && mean.lpips)
+      *mean.lpips += *v.lpips;
+    else
+      mean.lpips.reset();
+  }
+  const double n = views.empty() ? 1.0 : double(views.size());
+  mean.psnr /= n;
+  mean.ssim /= n;
+  if (mean.lpips) *mean.lpips /= n;
+  if (views.empty()) mean.lpips.reset();
+  return mean;
+}
+
+void write_report(const std::filesystem::path& base, const MetricsReport& report) {
+  const ViewMetrics mean = report.mean();
+  nlohmann::json json = {
+      {"mean", to_json(mean)}, {"views", nlohmann::json::array()}, {"lpips", report.lpips_status}};
+  for (const ViewMetrics& v : report.views) json["views"].push_back(to_json(v));
+  write_file_atomically(base.string() + ".json", json.dump(2) + "\n");
+
+  std::string csv = "name,psnr,ssim,lpips\n";
+  for (const ViewMetrics& v : report.views) csv += csv_row(v);
+  csv += csv_row(mean);
+  write_file_atomically(base.string() + ".csv", csv);
+}
+
+}  // namespace iesrgs::eval

@@ -1,0 +1,33 @@
+#pragma once
+// Image-quality metrics as 3D super-resolution papers report them: PSNR over all pixels and
+// channels, and SSIM with an 11x11 Gaussian window (sigma 1.5), both on RGB in [0, 1].
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/image.hpp"
+
+namespace iesrgs::eval {
+
+// Both images RGB (HWC) of the same size; throws Error otherwise.
+double psnr(const Image& image, const Image& reference);
+double ssim(const Image& image, const Image& reference);
+
+struct ViewMetrics {
+  std::string name;
+  double psnr = 0, ssim = 0;
+  std::optional<double> lpips;
+};
+
+struct MetricsReport {
+  std::vector<ViewMetrics> views;
+  std::string lpips_status;  // "alex", "vgg", or why LPIPS is unavailable
+
+  ViewMetrics mean() const;  // name "mean"; lpips only when every view has it
+};
+
+// <path>.json (per view and mean) and <path>.csv (one row per view, then the mean), atomically.
+void write_report(const std::filesystem::path& path_without_extension, const MetricsReport& report);
+
+}  // namespace iesrgs::eval

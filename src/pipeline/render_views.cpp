@@ -1,0 +1,80 @@
+#include "pipeline/render_views.hpp"
+
+#include <fmt/core.h>
+#include <torch/torch.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "io/image.hpp"
+#include "io/npy.hpp"
+#include "raster/autograd.hpp"
+#include "raster/rasterizer.hpp"
+
+namespace iesrgs::pipeline {
+
+namespace {
+
+constexpr float kMinAlphaForDepth = 1e-4f;
+
+std::vector<float> to_vector(const torch::Tensor& tensor) {
+  const torch::Tensor flat = tensor.contiguous().view(-1);
+  return std::vector<float>(flat.data_ptr<float>(), flat.data_ptr<float>() + flat.numel());
+}
+
+}  // namespace
+
+RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
+                         const std::array<float, 3>& background) {
+  torch::NoGradGuard no_grad;
+  const raster::RenderOutput out =
+      raster::render(model.render_tensors(), raster::raster_camera<float>(camera), background);
+  const torch::Tensor drawn = out.alpha > kMinAlphaForDepth;
+  RenderedView view;
+  view.image = out.image.clamp(0, 1);
+  view.depth = torch::where(drawn, out.depth / out.alpha.clamp_min(kMinAlphaForDepth),
+                            torch::zeros_like(out.depth));
+  view.alpha = out.alpha;
+  return view;
+}
+
+Image8 tensor_to_image8(const torch::Tensor& chw) {
+  const torch::Tensor hwc =
+      (chw.clamp(0, 1) * 255.0f).round().to(torch::kUInt8).permute({1, 2, 0}).contiguous();
+  Image8 image(int(hwc.size(1)), int(hwc.size(0)), int(hwc.size(2)));
+  std::copy_n(hwc.data_ptr<uint8_t>(), image.data.size(), image.data.begin());
+  return image;
+}
+
+void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
+                         const RenderedView& view) {
+  const int height = int(view.depth.size(0)), width = int(view.depth.size(1));
+  write_png(dir / "rgb" / (name + ".png"), tensor_to_image8(view.image));
+  const std::vector<float> depth = to_vector(view.depth);
+  write_npy(dir / "depth" / (name + ".npy"), depth, {size_t(height), size_t(width)});
+  std::vector<uint16_t> depth16(depth.size());
+  for (size_t i = 0; i < depth.size(); ++i)
+    depth16[i] = uint16_t(std::clamp(std::lround(depth[i] * kDepthPngScale), 0L, 65535L));
+  write_png16(dir / "depth" / (name + ".png"), depth16, width, height);
+  write_png(dir / "alpha" / (name + ".png"), tensor_to_image8(view.alpha.unsqueeze(0)));
+}
+
+double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,
+                       const std::vector<Camera>& cameras, const std::array<float, 3>& background,
+                       double scale) {
+  double render_seconds = 0;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    const Camera camera = cameras[i].scaled(scale);
+    const auto start = std::chrono::steady_clock::now();
+    const RenderedView view = render_view(model, camera, background);
+    render_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    write_rendered_view(dir, camera.name, view);
+    if ((i + 1) % 20 == 0 || i + 1 == cameras.size())
+      fmt::print("rendered {}/{} views at {}x{}\n", i + 1, cameras.size(), camera.intrinsics.width,
+                 camera.intrinsics.height);
+  }
+  return cameras.empty() ? 0 : render_seconds / double(cameras.size());
+}
+
+}  // namespace iesrgs::pipeline

@@ -1,0 +1,42 @@
+#pragma once
+// Rendering a trained model from a set of cameras into files: RGB PNGs named after the ground
+// truth, depth as raw float32 .npy and 16-bit PNG, alpha as PNG. SR-splatting is the same with
+// cameras at s times the resolution.
+#include <torch/types.h>
+
+#include <array>
+#include <filesystem>
+#include <vector>
+
+#include "gs/model.hpp"
+#include "io/camera.hpp"
+#include "io/image.hpp"
+
+namespace iesrgs::pipeline {
+
+struct RenderedView {
+  torch::Tensor image;  // (3, H, W) in [0, 1], over the background
+  torch::Tensor depth;  // (H, W) expected camera z (blended z / alpha), 0 where nothing is drawn
+  torch::Tensor alpha;  // (H, W)
+};
+
+RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
+                         const std::array<float, 3>& background);
+
+// Depth PNGs store millimetres-like units: value = depth * kDepthPngScale, clamped to 16 bits.
+constexpr double kDepthPngScale = 1000.0;
+
+// Writes <dir>/rgb/<name>.png, <dir>/depth/<name>.npy and .png, <dir>/alpha/<name>.png.
+void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
+                         const RenderedView& view);
+
+// (3, H, W) float in [0, 1] as an 8-bit HWC image, and back.
+Image8 tensor_to_image8(const torch::Tensor& chw);
+
+// Renders every camera (at `scale` times its resolution) into `dir`, printing progress; returns
+// the mean rendering time in seconds per view.
+double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,
+                       const std::vector<Camera>& cameras, const std::array<float, 3>& background,
+                       double scale);
+
+}  // namespace iesrgs::pipeline

@@ -1,0 +1,91 @@
+// The training workflow through the binary: synth -> train -> render -> eval, and its errors.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "io/atomic_file.hpp"
+#include "io/image.hpp"
+#include "support/cli_run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace iesrgs {
+namespace {
+
+using testing::CliRun;
+using testing::contains;
+using testing::iesrgs;
+using testing::last_line;
+using testing::TempDir;
+
+TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 6 --test-views 2 --seed 2").status, 0);
+  const CliRun train =
+      iesrgs("train " + scene + " -o " + out +
+             " --preset fast --iterations 30 --mv 2 --seed 4 --set random_points=1500"
+             " --set init=random");
+  ASSERT_EQ(train.status, 0) << train.output;
+  EXPECT_TRUE(contains(train.output, "it/s")) << train.output;
+  for (const char* file : {"point_cloud.ply", "point_cloud_filter_baked.ply", "config.json",
+                           "training.json", "train_log.csv", "checkpoint.pt"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "run" / file)) << file;
+  const auto config = nlohmann::json::parse(read_file(dir / "run" / "config.json"));
+  EXPECT_EQ(config["views_per_iteration"], 2);
+  EXPECT_EQ(config["iterations"], 30);
+
+  const std::string renders = (dir / "renders").string();
+  const CliRun render = iesrgs("render " + out + " " + scene + " -o " + renders + " --scale 2");
+  ASSERT_EQ(render.status, 0) << render.output;
+  const ImageHeader rgb = read_image_header(dir / "renders" / "rgb" / "r_0.png");
+  EXPECT_EQ(rgb.width, 64);
+  EXPECT_TRUE(std::filesystem::exists(dir / "renders" / "depth" / "r_0.npy"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "renders" / "depth" / "r_0.png"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "renders" / "alpha" / "r_0.png"));
+
+  const std::string same_size = (dir / "same").string();
+  ASSERT_EQ(iesrgs("render " + out + " " + scene + " -o " + same_size).status, 0);
+  const CliRun eval = iesrgs("eval " + same_size + " " + scene);
+  ASSERT_EQ(eval.status, 0) << eval.output;
+  const auto metrics = nlohmann::json::parse(read_file(dir / "same" / "metrics.json"));
+  EXPECT_EQ(metrics["views"].size(), 2u);
+  EXPECT_GT(metrics["mean"]["psnr"].get<double>(), 10.0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "same" / "metrics.csv"));
+
+  const CliRun mismatch = iesrgs("eval " + renders + " " + scene);
+  EXPECT_EQ(mismatch.status, 1);
+  EXPECT_TRUE(contains(last_line(mismatch.output), "64x64 but its reference is 32x32"))
+      << mismatch.output;
+}
+
+TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModel) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 24 --views 4 --test-views 1").status, 0);
+  const std::string args = "train " + scene + " -o " + out + " --preset fast --iterations 10";
+  ASSERT_EQ(iesrgs(args + " --set random_points=500 --set init=random").status, 0);
+  const CliRun resumed = iesrgs(args + " --resume");
+  ASSERT_EQ(resumed.status, 0) << resumed.output;
+  EXPECT_TRUE(contains(resumed.output, "resuming")) << resumed.output;
+}
+
+TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 3 --test-views 1").status, 0);
+  const CliRun typo =
+      iesrgs("train " + scene + " -o " + (dir / "a").string() + " --set itrations=5");
+  EXPECT_EQ(typo.status, 1);
+  EXPECT_TRUE(contains(last_line(typo.output), "unknown training parameter \"itrations\""))
+      << typo.output;
+  const CliRun resume = iesrgs("train " + scene + " -o " + (dir / "b").string() + " --resume");
+  EXPECT_EQ(resume.status, 1);
+  EXPECT_TRUE(contains(last_line(resume.output), "config.json: missing")) << resume.output;
+  const CliRun model = iesrgs("render " + (dir / "nothing.ply").string() + " " + scene + " -o " +
+                              (dir / "r").string());
+  EXPECT_EQ(model.status, 1);
+  EXPECT_TRUE(contains(last_line(model.output), "nothing.ply")) << model.output;
+}
+
+}  // namespace
+}  // namespace iesrgs
