@@ -1,0 +1,53 @@
+// Google Benchmark timings of the per-iteration bookkeeping around the rasterizer: the fused Adam
+// step over every Gaussian parameter and the densification statistics of K rendered views.
+#include <benchmark/benchmark.h>
+#include <torch/torch.h>
+
+#include "gs/densify.hpp"
+#include "gs/optimizer.hpp"
+
+namespace iesrgs::gs {
+namespace {
+
+GaussianModel random_model(int64_t n) {
+  torch::manual_seed(1);
+  GaussianModel model;
+  model.set_params({torch::randn({n, 3}), torch::rand({n, 1, 3}), torch::zeros({n, 15, 3}),
+                    torch::zeros({n}), torch::full({n, 3}, -4.0f), torch::randn({n, 4})});
+  return model;
+}
+
+void fill_gradients(GaussianModel& model) {
+  for (int p = 0; p < kParamCount; ++p)
+    model.param(Param(p)).mutable_grad() = torch::randn_like(model.param(Param(p))) * 1e-3;
+}
+
+// Arg: Gaussians.
+void BM_AdamStep(benchmark::State& state) {
+  GaussianModel model = random_model(state.range(0));
+  GaussianOptimizer optimizer(model, LearningRates{}, 4.0);
+  fill_gradients(model);
+  for (auto _ : state) optimizer.step(model);
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+// Args: Gaussians, views per iteration.
+void BM_DensifyStatistics(benchmark::State& state) {
+  const int64_t n = state.range(0);
+  DensifyStats stats = DensifyStats::zeros(n);
+  std::vector<ViewStatistics> views;
+  for (int64_t v = 0; v < state.range(1); ++v)
+    views.push_back(
+        {torch::randn({n, 2}), torch::rand({n, 2}), torch::randint(0, 20, {n}, torch::kInt32)});
+  for (auto _ : state) stats.accumulate(views);
+}
+
+BENCHMARK(BM_AdamStep)->Arg(100000)->Arg(500000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DensifyStatistics)
+    ->Args({100000, 1})
+    ->Args({100000, 3})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace iesrgs::gs
