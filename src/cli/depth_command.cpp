@@ -1,0 +1,72 @@
+// iesrgs depth: monocular relative depth (inverse depth) for one image or a folder of them.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "cli/commands.hpp"
+#include "core/error.hpp"
+#include "io/image.hpp"
+#include "priors/depth/depth_files.hpp"
+#include "priors/depth/depth_net.hpp"
+#include "priors/sr/image_tensor.hpp"
+
+namespace iesrgs::cli {
+
+namespace {
+
+struct DepthArgs {
+  std::string model = "depth-anything-v2";
+  std::string weights, in, out;
+  float background = 0.f;
+};
+
+void run_depth(const DepthArgs& args) {
+  using priors::depth::DepthJob;
+  const std::vector<DepthJob> jobs = priors::depth::plan_depth_jobs(args.in, args.out);
+  const std::unique_ptr<priors::depth::DepthNet> net =
+      priors::depth::make_depth_net(args.model, args.weights);
+  if (!net) fail("depth: model '{}' predicts nothing, so there is nothing to write", args.model);
+  const float background[3] = {args.background, args.background, args.background};
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    const Image rgb = composite_rgb(read_image8(jobs[i].image), background);
+    priors::depth::write_depth_outputs(net->predict(priors::sr::to_tensor(rgb)), jobs[i]);
+    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+    fmt::print("[{}/{}] {} -> {} ({}x{}, {:.2f} s)\n", i + 1, jobs.size(), jobs[i].image.string(),
+               jobs[i].npy.string(), rgb.width, rgb.height, elapsed.count());
+  }
+}
+
+}  // namespace
+
+void add_depth_command(CLI::App& app) {
+  auto* command = app.add_subcommand(
+      "depth",
+      "Predict relative inverse depth for an image or a folder of PNG / JPEG images: a float32 "
+      ".npy of the raw values and a false-color preview PNG (<name>_preview.png) per image");
+  auto args = std::make_shared<DepthArgs>();
+  command
+      ->add_option("--model", args->model,
+                   "depth-anything-v2-vits, -vitb, -vitl, or depth-anything-v2 to take the "
+                   "encoder from the checkpoint")
+      ->capture_default_str();
+  command
+      ->add_option("--weights", args->weights,
+                   "The authors' checkpoint, depth_anything_v2_<vits|vitb|vitl>.pth")
+      ->required();
+  command
+      ->add_option("--background", args->background,
+                   "Gray level in [0, 1] that transparent pixels are composited over")
+      ->check(CLI::Range(0.f, 1.f))
+      ->capture_default_str();
+  command->add_option("IN", args->in, "An image, or a folder of images")->required();
+  command
+      ->add_option("OUT", args->out,
+                   "For an image: the .npy to write; for a folder: the folder to write into")
+      ->required();
+  command->callback([args] { run_depth(*args); });
+}
+
+}  // namespace iesrgs::cli

@@ -1,0 +1,77 @@
+#include "priors/depth/depth_files.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <set>
+#include <string>
+
+#include "core/error.hpp"
+#include "io/image.hpp"
+#include "io/npy.hpp"
+#include "priors/depth/depth_preview.hpp"
+
+namespace iesrgs::priors::depth {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+bool is_image(const fs::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return extension == ".png" || extension == ".jpg" || extension == ".jpeg";
+}
+
+fs::path preview_path(fs::path npy) {
+  return npy.replace_filename(npy.stem().string() + "_preview.png");
+}
+
+std::vector<fs::path> images_in(const fs::path& folder) {
+  std::vector<fs::path> images;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+    if (entry.is_regular_file() && is_image(entry.path())) images.push_back(entry.path());
+  if (images.empty()) fail_file(folder, "no PNG or JPEG images in this folder");
+  std::sort(images.begin(), images.end());
+  return images;
+}
+
+// Two images with one stem (a.png, a.jpg), or an output folder that is the input one, would
+// otherwise overwrite results or inputs without a word.
+void check_names_unique(const std::vector<DepthJob>& jobs) {
+  std::set<fs::path> taken;
+  for (const DepthJob& job : jobs) taken.insert(fs::weakly_canonical(job.image));
+  for (const DepthJob& job : jobs)
+    for (const fs::path& output : {job.npy, job.preview})
+      if (!taken.insert(fs::weakly_canonical(output)).second)
+        fail_file(output, "would be written twice or overwrite an input image");
+}
+
+}  // namespace
+
+std::vector<DepthJob> plan_depth_jobs(const fs::path& in, const fs::path& out) {
+  std::vector<DepthJob> jobs;
+  if (fs::is_directory(in)) {
+    for (const fs::path& image : images_in(in)) {
+      const fs::path npy = out / image.filename().replace_extension(".npy");
+      jobs.push_back({image, npy, preview_path(npy)});
+    }
+  } else {
+    if (!fs::exists(in)) fail_file(in, "no such image or folder");
+    if (out.extension() != ".npy") fail_file(out, "the output of a single image must end in .npy");
+    jobs.push_back({in, out, preview_path(out)});
+  }
+  check_names_unique(jobs);
+  return jobs;
+}
+
+void write_depth_outputs(const torch::Tensor& depth, const DepthJob& job) {
+  const torch::Tensor map = depth.detach().to(torch::kCPU, torch::kFloat32).contiguous();
+  const Image8 preview = depth_preview(map);  // also rejects anything but an (H, W) map
+  const float* values = map.data_ptr<float>();
+  write_npy(job.npy, std::vector<float>(values, values + map.numel()),
+            {size_t(map.size(0)), size_t(map.size(1))});
+  write_png(job.preview, preview);
+}
+
+}  // namespace iesrgs::priors::depth

@@ -1,0 +1,53 @@
+#include "priors/depth/depth_net.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "core/error.hpp"
+#include "priors/depth/depth_anything.hpp"
+
+namespace iesrgs::priors::depth {
+
+namespace {
+
+const std::string kDepthAnything = "depth-anything-v2";
+
+// "depth-anything-v2-vits" -> "vits"; "depth-anything-v2" -> "" (take it from the checkpoint).
+std::string requested_encoder(const std::string& model) {
+  if (model == kDepthAnything) return "";
+  const std::string prefix = kDepthAnything + "-";
+  const std::string encoder = model.substr(std::min(prefix.size(), model.size()));
+  if (model.compare(0, prefix.size(), prefix) != 0 ||
+      (encoder != "vits" && encoder != "vitb" && encoder != "vitl"))
+    fail(
+        "unknown depth model '{}' (expected depth-anything-v2, depth-anything-v2-vits, "
+        "depth-anything-v2-vitb, depth-anything-v2-vitl or none)",
+        model);
+  return encoder;
+}
+
+}  // namespace
+
+std::unique_ptr<DepthNet> make_depth_net(const std::string& model,
+                                         const std::filesystem::path& weights,
+                                         torch::Device device) {
+  if (model == "none") {
+    spdlog::info("depth model: none, so the external depth loss is off");
+    return nullptr;
+  }
+  const std::string requested = requested_encoder(model);
+  if (weights.empty())
+    fail("{} needs the authors' checkpoint (depth_anything_v2_{}.pth) as its weights", model,
+         requested.empty() ? "vitl" : requested);
+  const StateDict state = read_state_dict(weights);
+  const std::string encoder = depth_anything_encoder(state, weights);
+  if (!requested.empty() && encoder != requested)
+    fail_file(weights,
+              fmt::format("holds a Depth Anything V2 {} model, not the {} that {} asks for",
+                          encoder, requested, model));
+  DepthAnythingV2 network = load_depth_anything(depth_anything_config(encoder), state, weights);
+  network->to(device);
+  spdlog::info("depth model: Depth Anything V2 {} from {}", encoder, weights.string());
+  return std::make_unique<DepthAnythingNet>(std::move(network), kDepthAnything + "-" + encoder);
+}
+
+}  // namespace iesrgs::priors::depth
