@@ -11,6 +11,8 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libstb-dev libfmt-dev libspdlog-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
+# npm fetches the default super-resolution model (below); a Node.js install may already ship it.
+command -v npm >/dev/null || PACKAGES+=(npm)
 
 missing=()
 for package in "${PACKAGES[@]}"; do
@@ -23,6 +25,13 @@ if ((${#missing[@]})); then
   [ "$(id -u)" -eq 0 ] || sudo="sudo"
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# The default super-resolution prior: the MIT-licensed pre-trained ESRGAN models of UpscalerJS
+# (TensorFlow.js layers models), looked up at run time in $IESRGS_NPM_DIR or third_party/npm.
+if [ ! -f third_party/npm/node_modules/@upscalerjs/esrgan-slim/models/x4/model.json ]; then
+  npm install --prefix third_party/npm --no-save --omit=peer --no-audit --no-fund \
+    @upscalerjs/esrgan-slim@1.0.0
 fi
 
 build_dir=build

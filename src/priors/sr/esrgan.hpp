@@ -1,0 +1,23 @@
+#pragma once
+// The offline default super-resolution prior: the pre-trained ESRGAN generators (RDN and RRDN
+// trained on DIV2K) that UpscalerJS publishes on npm under the MIT license as TensorFlow.js
+// layers models, @upscalerjs/esrgan-slim, -medium and -thick, each for x2, x3, x4 and x8.
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "priors/sr/sr_net.hpp"
+
+namespace iesrgs::priors::sr {
+
+// @upscalerjs/esrgan-<variant> ("slim", "medium" or "thick") at `scale` (2, 3, 4 or 8), read from
+// `package_dir`, the package's folder (holding models/x<scale>/model.json); an empty path selects
+// default_esrgan_package_dir(variant). Throws Error naming the model or file and the problem.
+std::unique_ptr<SrNet> make_esrgan(const std::string& variant, int scale,
+                                   const std::filesystem::path& package_dir);
+
+// <npm dir>/node_modules/@upscalerjs/esrgan-<variant>, where <npm dir> is $IESRGS_NPM_DIR or, when
+// that is unset, third_party/npm in the source tree (scripts/setup.sh installs esrgan-slim there).
+std::filesystem::path default_esrgan_package_dir(const std::string& variant);
+
+}  // namespace iesrgs::priors::sr
