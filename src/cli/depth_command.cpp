@@ -8,9 +8,9 @@
 #include "cli/commands.hpp"
 #include "core/error.hpp"
 #include "io/image.hpp"
+#include "io/image_tensor.hpp"
 #include "priors/depth/depth_files.hpp"
 #include "priors/depth/depth_net.hpp"
-#include "priors/sr/image_tensor.hpp"
 
 namespace iesrgs::cli {
 
@@ -32,7 +32,7 @@ void run_depth(const DepthArgs& args) {
   for (size_t i = 0; i < jobs.size(); ++i) {
     const auto start = std::chrono::steady_clock::now();
     const Image rgb = composite_rgb(read_image8(jobs[i].image), background);
-    priors::depth::write_depth_outputs(net->predict(priors::sr::to_tensor(rgb)), jobs[i]);
+    priors::depth::write_depth_outputs(net->predict(to_tensor(rgb)), jobs[i]);
     const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
     fmt::print("[{}/{}] {} -> {} ({}x{}, {:.2f} s)\n", i + 1, jobs.size(), jobs[i].image.string(),
                jobs[i].npy.string(), rgb.width, rgb.height, elapsed.count());

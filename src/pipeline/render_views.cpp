@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "io/image.hpp"
+#include "io/image_tensor.hpp"
 #include "io/npy.hpp"
 #include "raster/autograd.hpp"
 #include "raster/rasterizer.hpp"
@@ -20,6 +21,13 @@ constexpr float kMinAlphaForDepth = 1e-4f;
 std::vector<float> to_vector(const torch::Tensor& tensor) {
   const torch::Tensor flat = tensor.contiguous().view(-1);
   return std::vector<float>(flat.data_ptr<float>(), flat.data_ptr<float>() + flat.numel());
+}
+
+Image8 gray_image8(const torch::Tensor& plane) {
+  const torch::Tensor bytes = (plane.clamp(0, 1) * 255.0f).round().to(torch::kUInt8).contiguous();
+  Image8 image(int(plane.size(1)), int(plane.size(0)), 1);
+  std::copy_n(bytes.data_ptr<uint8_t>(), image.data.size(), image.data.begin());
+  return image;
 }
 
 }  // namespace
@@ -38,25 +46,17 @@ RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
   return view;
 }
 
-Image8 tensor_to_image8(const torch::Tensor& chw) {
-  const torch::Tensor hwc =
-      (chw.clamp(0, 1) * 255.0f).round().to(torch::kUInt8).permute({1, 2, 0}).contiguous();
-  Image8 image(int(hwc.size(1)), int(hwc.size(0)), int(hwc.size(2)));
-  std::copy_n(hwc.data_ptr<uint8_t>(), image.data.size(), image.data.begin());
-  return image;
-}
-
 void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
                          const RenderedView& view) {
   const int height = int(view.depth.size(0)), width = int(view.depth.size(1));
-  write_png(dir / "rgb" / (name + ".png"), tensor_to_image8(view.image));
+  write_png(dir / "rgb" / (name + ".png"), to_image8(view.image.unsqueeze(0)));
   const std::vector<float> depth = to_vector(view.depth);
   write_npy(dir / "depth" / (name + ".npy"), depth, {size_t(height), size_t(width)});
   std::vector<uint16_t> depth16(depth.size());
   for (size_t i = 0; i < depth.size(); ++i)
     depth16[i] = uint16_t(std::clamp(std::lround(depth[i] * kDepthPngScale), 0L, 65535L));
   write_png16(dir / "depth" / (name + ".png"), depth16, width, height);
-  write_png(dir / "alpha" / (name + ".png"), tensor_to_image8(view.alpha.unsqueeze(0)));
+  write_png(dir / "alpha" / (name + ".png"), gray_image8(view.alpha));
 }
 
 double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,

@@ -30,9 +30,6 @@ constexpr double kDepthPngScale = 1000.0;
 void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
                          const RenderedView& view);
 
-// (3, H, W) float in [0, 1] as an 8-bit HWC image, and back.
-Image8 tensor_to_image8(const torch::Tensor& chw);
-
 // Renders every camera (at `scale` times its resolution) into `dir`, printing progress; returns
 // the mean rendering time in seconds per view.
 double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,

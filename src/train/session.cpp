@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "core/error.hpp"
+#include "io/image_tensor.hpp"
 #include "io/ply.hpp"
 
 namespace iesrgs::train {
@@ -10,7 +11,7 @@ namespace iesrgs::train {
 std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images) {
   std::vector<TrainView> views;
   for (const Camera* camera : scene.split(split))
-    views.push_back({*camera, to_chw_tensor(*images.rgb(*camera))});
+    views.push_back({*camera, to_tensor(*images.rgb(*camera))[0]});
   return views;
 }
 

@@ -73,14 +73,6 @@ bool all_finite(const gs::GaussianModel& model) {
 
 }  // namespace
 
-torch::Tensor to_chw_tensor(const Image& image) {
-  if (image.channels != 3) fail("expected an RGB image, got {} channels", image.channels);
-  return torch::from_blob(const_cast<float*>(image.data.data()), {image.height, image.width, 3},
-                          torch::kFloat32)
-      .permute({2, 0, 1})
-      .contiguous();
-}
-
 Trainer::Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianModel initial)
     : config_(config), setup_(std::move(setup)), model_(std::move(initial)) {
   validate(config_);

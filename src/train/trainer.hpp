@@ -13,7 +13,6 @@
 
 #include "gs/model.hpp"
 #include "io/camera.hpp"
-#include "io/image.hpp"
 #include "raster/autograd.hpp"
 #include "train/config.hpp"
 
@@ -84,8 +83,5 @@ class Trainer {
   int64_t iteration_ = 0;              // completed iterations
   int64_t checkpoint_iteration_ = -1;  // of the last checkpoint written or read
 };
-
-// The cameras' image as a (3, H, W) float tensor, from the HWC images the loaders produce.
-torch::Tensor to_chw_tensor(const Image& image);
 
 }  // namespace iesrgs::train

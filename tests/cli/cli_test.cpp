@@ -3,8 +3,10 @@
 
 #include <cstdio>
 #include <string>
+#include <tuple>
 
 #include "io/atomic_file.hpp"
+#include "io/image.hpp"
 #include "support/cli_run.hpp"
 #include "support/temp_dir.hpp"
 
@@ -60,6 +62,30 @@ TEST(Cli, BadDownscaleIsRejected) {
   const CliRun run = iesrgs("info . --downscale 0");
   EXPECT_NE(run.status, 0);
   EXPECT_TRUE(contains(run.output, "--downscale")) << run.output;
+}
+
+TEST(Cli, UpscaleWritesOnePngPerImageOfAFolder) {
+  TempDir dir;
+  write_png(dir / "in" / "a.png", Image8(10, 8, 4));
+  write_png(dir / "in" / "b.png", Image8(6, 5, 3));
+  write_text(dir / "in" / "notes.txt", "not an image");
+  const CliRun run = iesrgs("upscale --model bicubic --scale 2 " + (dir / "in").string() + " " +
+                            (dir / "out").string());
+  EXPECT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(contains(run.output, "[2/2]")) << run.output;
+  const ImageHeader a = read_image_header(dir / "out" / "a.png");
+  const ImageHeader b = read_image_header(dir / "out" / "b.png");
+  EXPECT_EQ(std::make_tuple(a.width, a.height, a.channels), std::make_tuple(20, 16, 3));
+  EXPECT_EQ(std::make_tuple(b.width, b.height, b.channels), std::make_tuple(12, 10, 3));
+}
+
+TEST(Cli, UpscaleOfAMissingInputNamesIt) {
+  TempDir dir;
+  const CliRun run =
+      iesrgs("upscale --model bicubic " + (dir / "nothing.png").string() + " out.png");
+  EXPECT_EQ(run.status, 1);
+  EXPECT_EQ(last_line(run.output),
+            "error: " + (dir / "nothing.png").string() + ": no such image or folder");
 }
 
 }  // namespace

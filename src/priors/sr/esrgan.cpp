@@ -9,7 +9,7 @@
 
 #include "core/error.hpp"
 #include "priors/keras_model.hpp"
-#include "priors/sr/image_tensor.hpp"
+#include "io/image_tensor.hpp"
 
 namespace iesrgs::priors::sr {
 

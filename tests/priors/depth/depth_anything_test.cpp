@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "io/image.hpp"
+#include "io/image_tensor.hpp"
 #include "io/npy.hpp"
-#include "priors/sr/image_tensor.hpp"
 #include "support/expect_error.hpp"
 
 namespace iesrgs::priors::depth {
@@ -28,7 +28,7 @@ torch::Tensor read_tensor(const std::string& name) {
 
 torch::Tensor fixture_image() {
   const float black[3] = {0, 0, 0};
-  return sr::to_tensor(composite_rgb(read_image8(kData / "image.png"), black));
+  return to_tensor(composite_rgb(read_image8(kData / "image.png"), black));
 }
 
 // The sizes make_fixtures.py gives the official classes.

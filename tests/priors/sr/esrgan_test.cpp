@@ -11,7 +11,7 @@
 #include "io/npy.hpp"
 #include "io/resize.hpp"
 #include "priors/keras_model.hpp"
-#include "priors/sr/image_tensor.hpp"
+#include "io/image_tensor.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 

@@ -1,11 +1,11 @@
-#include "priors/sr/image_tensor.hpp"
+#include "io/image_tensor.hpp"
 
 #include <algorithm>
 #include <sstream>
 
 #include "core/error.hpp"
 
-namespace iesrgs::priors::sr {
+namespace iesrgs {
 
 namespace {
 
@@ -26,10 +26,11 @@ std::string shape_of(const torch::Tensor& tensor) {
 
 torch::Tensor to_tensor(const Image& rgb) {
   if (rgb.channels != 3) fail("image conversion: expected 3 channels, got {}", rgb.channels);
-  // from_blob borrows the image's storage; the permuted copy owns its own.
+  // from_blob borrows the image's storage; the clone owns its own (contiguous() would not copy a
+  // 1x1 image, whose permuted view already counts as contiguous).
   const torch::Tensor hwc = torch::from_blob(const_cast<float*>(rgb.data.data()),
                                              {rgb.height, rgb.width, 3}, torch::kFloat32);
-  return hwc.permute({2, 0, 1}).unsqueeze(0).contiguous();
+  return hwc.permute({2, 0, 1}).unsqueeze(0).clone(torch::MemoryFormat::Contiguous);
 }
 
 Image to_image(const torch::Tensor& rgb) {
@@ -62,4 +63,4 @@ void check_rgb_batch(const torch::Tensor& rgb, const std::string& model) {
   if (rgb.size(2) < 1 || rgb.size(3) < 1) fail("{}: empty image", model);
 }
 
-}  // namespace iesrgs::priors::sr
+}  // namespace iesrgs

@@ -7,7 +7,7 @@
 
 #include "io/image.hpp"
 
-namespace iesrgs::priors::sr {
+namespace iesrgs {
 
 // RGB image -> (1, 3, H, W) float32, contiguous. Throws Error unless it has 3 channels.
 torch::Tensor to_tensor(const Image& rgb);
@@ -19,4 +19,4 @@ Image8 to_image8(const torch::Tensor& rgb);
 // Throws Error("<model>: ...") unless `rgb` is a float32 CPU tensor of shape (1, 3, H, W).
 void check_rgb_batch(const torch::Tensor& rgb, const std::string& model);
 
-}  // namespace iesrgs::priors::sr
+}  // namespace iesrgs

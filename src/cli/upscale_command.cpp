@@ -1,0 +1,129 @@
+// iesrgs upscale: 2D super-resolution of one image or a folder of images with any backend of
+// the registry (bicubic, SAFMN, IMDN, PAN, SwinIR, ...), tiled so large inputs fit in memory.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cli/commands.hpp"
+#include "core/error.hpp"
+#include "io/image.hpp"
+#include "io/image_tensor.hpp"
+#include "priors/sr/registry.hpp"
+#include "priors/sr/sr_net.hpp"
+#include "priors/sr/tiling.hpp"
+
+namespace iesrgs::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using priors::sr::SrNet;
+
+struct UpscaleArgs {
+  std::string model;
+  fs::path weights;
+  int scale = 4;
+  priors::sr::TileOptions tiles{256, 32};
+  float background = 1.f;
+  fs::path input, output;
+};
+
+struct Job {
+  fs::path input, output;
+};
+
+bool is_image_file(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+}
+
+// Every PNG / JPEG of `folder`, in name order, to a PNG of the same stem in `out`.
+std::vector<Job> folder_jobs(const fs::path& folder, const fs::path& out) {
+  if (fs::exists(out) && !fs::is_directory(out))
+    fail_file(out, "is a file, but the input is a folder");
+  std::vector<Job> jobs;
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (entry.is_regular_file() && is_image_file(entry.path()))
+      jobs.push_back({entry.path(), out / entry.path().stem().concat(".png")});
+  if (jobs.empty()) fail_file(folder, "no PNG or JPEG images in this folder");
+  std::sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.input < b.input; });
+  return jobs;
+}
+
+std::vector<Job> jobs_for(const fs::path& input, const fs::path& output) {
+  if (fs::is_directory(input)) return folder_jobs(input, output);
+  if (!fs::exists(input)) fail_file(input, "no such image or folder");
+  if (fs::is_directory(output)) return {{input, output / input.stem().concat(".png")}};
+  return {{input, output}};
+}
+
+// Decodes, composites any alpha over the background, upscales and writes one image.
+std::pair<int, int> upscale_one(SrNet& net, const UpscaleArgs& args, const Job& job) {
+  const float background[3] = {args.background, args.background, args.background};
+  const Image rgb = composite_rgb(read_image8(job.input), background);
+  const torch::Tensor upscaled = priors::sr::upscale_tiled(net, to_tensor(rgb), args.tiles);
+  write_png(job.output, to_image8(upscaled));
+  return {rgb.width, rgb.height};
+}
+
+void run(const UpscaleArgs& args) {
+  const std::vector<Job> jobs = jobs_for(args.input, args.output);
+  const std::unique_ptr<SrNet> net = priors::sr::make_sr_net(args.model, args.weights, args.scale);
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    const auto [width, height] = upscale_one(*net, args, jobs[i]);
+    const std::chrono::duration<double> seconds = std::chrono::steady_clock::now() - start;
+    fmt::print("[{}/{}] {} {}x{} -> {} {}x{} ({:.2f} s)\n", i + 1, jobs.size(),
+               jobs[i].input.string(), width, height, jobs[i].output.string(), width * args.scale,
+               height * args.scale, seconds.count());
+    std::fflush(stdout);
+  }
+}
+
+}  // namespace
+
+void add_upscale_command(CLI::App& app) {
+  auto* command = app.add_subcommand(
+      "upscale", "Super-resolve an image, or every PNG / JPEG of a folder, with a 2D SR network");
+  auto args = std::make_shared<UpscaleArgs>();
+  std::string models;
+  for (const std::string& name : priors::sr::sr_model_names())
+    models += (models.empty() ? "" : ", ") + name;
+  command->add_option("--model", args->model, "Backend: " + models)->required();
+  command
+      ->add_option("--weights", args->weights,
+                   "Checkpoint (.pth), or package folder for esrgan-*; default "
+                   "<weights dir>/sr/<MODEL>_x<scale>.pth, the weights dir being "
+                   "$IESRGS_WEIGHTS_DIR or the development data")
+      ->check(CLI::ExistingPath);
+  command->add_option("--scale", args->scale, "Upscaling factor")->capture_default_str();
+  command
+      ->add_option("--tile", args->tiles.tile,
+                   "Tile side in input pixels, 0 for the whole image at once")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  command
+      ->add_option("--tile-overlap", args->tiles.overlap,
+                   "Input pixels shared by neighbouring tiles, cross-faded")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  command
+      ->add_option("--background", args->background,
+                   "Gray level in [0, 1] that transparent pixels are composited over")
+      ->capture_default_str()
+      ->check(CLI::Range(0.f, 1.f));
+  command->add_option("input", args->input, "Image or folder of images")->required();
+  command->add_option("output", args->output, "PNG file, or folder for a folder input")->required();
+  command->callback([args] { run(*args); });
+}
+
+}  // namespace iesrgs::cli

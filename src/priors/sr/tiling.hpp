@@ -1,0 +1,23 @@
+#pragma once
+// Tiled super-resolution: the image is upscaled in overlapping tiles and the overlaps are
+// cross-faded, so memory is bounded by the output plus one tile's activations (a 1080p input
+// at x4 never holds a full-resolution feature map).
+#include <torch/torch.h>
+
+#include "priors/sr/sr_net.hpp"
+
+namespace iesrgs::priors::sr {
+
+struct TileOptions {
+  int tile = 0;  // side of a tile in input pixels; 0 upscales the whole image at once
+  // Input pixels shared by neighbouring tiles. The outer quarter of an overlap is context only
+  // (weight 0), the middle half is cross-faded linearly, so tiles agree with the whole-image
+  // result wherever the network's receptive field stays within a quarter of the overlap.
+  int overlap = 32;
+};
+
+// `net`'s upscale of `rgb` (1, 3, H, W), tile by tile when options.tile is smaller than a side.
+// Throws Error for an overlap that is negative or not smaller than the tile.
+torch::Tensor upscale_tiled(SrNet& net, const torch::Tensor& rgb, const TileOptions& options);
+
+}  // namespace iesrgs::priors::sr

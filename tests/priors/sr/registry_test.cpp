@@ -1,0 +1,117 @@
+#include "priors/sr/registry.hpp"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <cstdio>
+#include <map>
+#include <optional>
+
+#include "priors/sr/sr_test_support.hpp"
+#include "support/expect_error.hpp"
+#include "support/temp_dir.hpp"
+
+namespace iesrgs::priors::sr {
+namespace {
+
+using iesrgs::testing::error_message;
+using iesrgs::testing::TempDir;
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// Sets (or with no value unsets) IESRGS_WEIGHTS_DIR for the scope and restores what was there.
+class WeightsDirOverride {
+ public:
+  explicit WeightsDirOverride(const std::optional<std::filesystem::path>& dir) {
+    if (const char* old = std::getenv(kName)) old_ = old;
+    set(dir ? std::optional<std::string>(dir->string()) : std::nullopt);
+  }
+  ~WeightsDirOverride() { set(old_); }
+
+ private:
+  static void set(const std::optional<std::string>& value) {
+    if (value)
+      ::setenv(kName, value->c_str(), 1);
+    else
+      ::unsetenv(kName);
+  }
+
+  static constexpr const char* kName = "IESRGS_WEIGHTS_DIR";
+  std::optional<std::string> old_;
+};
+
+TEST(SrRegistry, KnowsTheBuiltInModels) {
+  const std::vector<std::string>& names = sr_model_names();
+  for (const char* model : {"bicubic", "safmn", "imdn", "pan", "swinir", "esrgan-slim",
+                            "esrgan-medium", "esrgan-thick"})
+    EXPECT_NE(std::find(names.begin(), names.end(), model), names.end()) << model;
+  const auto net = make_sr_net("bicubic", {}, 4);
+  EXPECT_EQ(net->name(), "bicubic");
+  EXPECT_EQ(net->scale(), 4);
+}
+
+TEST(SrRegistry, UnknownModelAndBadScaleAreErrors) {
+  const std::string unknown = error_message([] { make_sr_net("edsr", {}, 4); });
+  EXPECT_TRUE(contains(unknown, "'edsr'") && contains(unknown, "safmn")) << unknown;
+  EXPECT_EQ(error_message([] { make_sr_net("pan", {}, 0); }), "pan: invalid scale 0");
+}
+
+TEST(SrRegistry, DefaultWeightsFollowTheEnvironment) {
+  WeightsDirOverride weights("/opt/weights");
+  EXPECT_EQ(default_sr_weights("safmn", 4), "/opt/weights/sr/SAFMN_x4.pth");
+  EXPECT_EQ(default_sr_weights("pan", 2), "/opt/weights/sr/PAN_x2.pth");
+}
+
+TEST(SrRegistry, DefaultWeightsAreTheDevelopmentDataOtherwise) {
+  WeightsDirOverride weights(std::nullopt);
+  EXPECT_EQ(default_weights_dir(), std::filesystem::path(IESRGS_SHARED_DATA) / "weights");
+}
+
+TEST(SrRegistry, MissingDefaultWeightsSayWhereTheyWereLookedFor) {
+  TempDir dir;
+  WeightsDirOverride weights(dir.path());
+  const std::string message = error_message([] { make_sr_net("imdn", {}, 4); });
+  EXPECT_TRUE(contains(message, (dir / "sr" / "IMDN_x4.pth").string())) << message;
+  EXPECT_TRUE(contains(message, "IESRGS_WEIGHTS_DIR")) << message;
+}
+
+TEST(SrRegistry, CheckpointOfAnotherConfigurationNamesTheFile) {
+  const auto file = testing::kFixtures / "tiny_pan_x2.pth";
+  const std::string message = error_message([&] { make_sr_net("pan", file, 4); });
+  EXPECT_TRUE(contains(message, file.string())) << message;
+}
+
+TEST(SrRegistry, NetworksRejectInputsThatAreNotRgbBatches) {
+  const auto file = testing::kReleasedWeights / "PAN_x4.pth";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found (shared data absent)";
+  const auto net = make_sr_net("pan", file, 4);
+  EXPECT_EQ(error_message([&] {
+              net->upscale(torch::zeros({3, 8, 8}));
+            }),
+            "pan: expected an RGB batch of shape (1, 3, H, W), got [3, 8, 8]");
+}
+
+// The x4 benchmark protocol on lego test views, per backend. A measurement rather than a check
+// (seconds of CPU per view and network): run it with --gtest_also_run_disabled_tests.
+TEST(SrMeasurement, DISABLED_LegoTestViewPsnr) {
+  if (!std::filesystem::exists(default_sr_weights("safmn", 4)))
+    GTEST_SKIP() << default_sr_weights("safmn", 4) << " not found (shared data absent)";
+  const std::vector<int> views = {0, 20, 40, 60, 80, 100, 120, 140, 160, 180};
+  std::map<std::string, double> mean;
+  for (const std::string model : {"bicubic", "safmn", "imdn", "pan"}) {
+    const auto net = make_sr_net(model, {}, 4);
+    for (const int index : views) {
+      const testing::ProtocolView view = testing::lego_test_view(index);
+      mean[model] += testing::psnr(net->upscale(view.low), view.high) / double(views.size());
+    }
+    std::printf("%-8s %.2f dB mean over %zu lego test views\n", model.c_str(), mean[model],
+                views.size());
+  }
+  for (const char* model : {"safmn", "imdn", "pan"})
+    EXPECT_GT(mean[model], mean["bicubic"] + 3) << model;
+}
+
+}  // namespace
+}  // namespace iesrgs::priors::sr

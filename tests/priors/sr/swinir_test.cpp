@@ -1,0 +1,201 @@
+#include "priors/sr/swinir.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "io/npy.hpp"
+#include "support/expect_error.hpp"
+
+// Fixtures come from tests/data/priors/swinir/make_fixtures.py, which runs the authors'
+// network_swinir.py: small official-layout networks with seeded weights, their input and
+// output under the official test procedure, and the state-dict layout of SwinIR-M x4 and
+// SwinIR-S x2.
+namespace iesrgs::priors::sr {
+namespace {
+
+using testing::error_message;
+
+const std::filesystem::path kData = std::filesystem::path(IESRGS_TEST_DATA) / "priors/swinir";
+
+using Shapes = std::map<std::string, std::vector<int64_t>>;
+
+Shapes read_shapes(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  EXPECT_TRUE(in) << file;
+  Shapes shapes;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    std::string name;
+    fields >> name;
+    int64_t dim = 0;
+    while (fields >> dim) shapes[name].push_back(dim);
+  }
+  return shapes;
+}
+
+Shapes shapes_of(torch::nn::Module& module) {
+  Shapes shapes;
+  for (const auto& item : module.named_parameters())
+    shapes[item.key()] = item.value().sizes().vec();
+  for (const auto& item : module.named_buffers()) shapes[item.key()] = item.value().sizes().vec();
+  return shapes;
+}
+
+// A state dict with the module's layout; only shapes matter to inference, so no memory is filled.
+StateDict layout_of(torch::nn::Module& module) {
+  StateDict weights;
+  for (const auto& [name, shape] : shapes_of(module))
+    weights[name] = torch::zeros({}).expand(shape);
+  return weights;
+}
+
+torch::Tensor read_npy_tensor(const std::filesystem::path& file) {
+  NpyArray array = read_npy(file);
+  const std::vector<int64_t> shape(array.shape.begin(), array.shape.end());
+  return torch::from_blob(array.data.data(), shape, torch::kFloat).clone();
+}
+
+void expect_same_config(const SwinIRConfig& a, const SwinIRConfig& b) {
+  EXPECT_EQ(a.embed_dim, b.embed_dim);
+  EXPECT_EQ(a.depths, b.depths);
+  EXPECT_EQ(a.num_heads, b.num_heads);
+  EXPECT_EQ(a.window_size, b.window_size);
+  EXPECT_EQ(a.mlp_hidden_dim, b.mlp_hidden_dim);
+  EXPECT_EQ(a.upsampler, b.upsampler);
+  EXPECT_EQ(a.scale, b.scale);
+  if (a.upsampler == SwinIRUpsampler::PixelShuffle) {
+    EXPECT_EQ(a.num_feat, b.num_feat);
+  }
+}
+
+TEST(SwinIR, RealConfigurationsHaveTheOfficialStateDictLayout) {
+  SwinIR m(swinir_m_config(4));
+  SwinIR s(swinir_s_config(2));
+  EXPECT_EQ(shapes_of(*m), read_shapes(kData / "swinir_m_x4_names.txt"));
+  EXPECT_EQ(shapes_of(*s), read_shapes(kData / "swinir_s_x2_names.txt"));
+  // The parameter counts the official code gives (11.9M as the paper reports for SwinIR-M).
+  const auto count = [](SwinIR& net) {
+    int64_t total = 0;
+    for (const auto& p : net->parameters()) total += p.numel();
+    return total;
+  };
+  EXPECT_EQ(count(m), 11900199);
+  EXPECT_EQ(count(s), 910152);
+}
+
+TEST(SwinIR, InfersEveryOfficialClassicalConfigurationFromShapes) {
+  std::vector<SwinIRConfig> configs;
+  for (int scale : {2, 3, 4, 8}) configs.push_back(swinir_m_config(scale));
+  for (int scale : {2, 3, 4}) configs.push_back(swinir_s_config(scale));
+  for (const SwinIRConfig& config : configs) {
+    SwinIR net(config);
+    SCOPED_TRACE("embed_dim " + std::to_string(config.embed_dim) + " x" +
+                 std::to_string(config.scale));
+    expect_same_config(infer_swinir_config(layout_of(*net), "net.pth"), config);
+  }
+}
+
+void expect_matches_official(const std::string& name, int scale) {
+  const std::unique_ptr<SrNet> net = make_swinir(kData / (name + ".pth"), scale);
+  EXPECT_EQ(net->scale(), scale);
+  const torch::Tensor input = read_npy_tensor(kData / (name + "_in.npy"));
+  const torch::Tensor expected = read_npy_tensor(kData / (name + "_out.npy"));
+  const torch::Tensor output = net->upscale(input);
+  ASSERT_EQ(output.sizes(), expected.sizes());
+  EXPECT_LT((output - expected).abs().max().item<float>(), 1e-4f);
+}
+
+// 13x21 input: both sides need padding.
+TEST(SwinIR, PixelShuffleMatchesOfficialCode) {
+  expect_matches_official("tiny_pixelshuffle_x2", 2);
+}
+
+// 16x11 input: the height, already a window multiple, still gets a whole window of mirror.
+TEST(SwinIR, PixelShuffleDirectMatchesOfficialCode) {
+  expect_matches_official("tiny_pixelshuffledirect_x3", 3);
+}
+
+TEST(SwinIR, LoadsWithAnExplicitConfiguration) {
+  const std::filesystem::path file = kData / "tiny_pixelshuffledirect_x3.pth";
+  SwinIRConfig config = swinir_s_config(3);
+  config.embed_dim = 16;
+  config.depths = {2, 3};
+  config.num_heads = {2, 4};
+  config.mlp_hidden_dim = 32;
+  EXPECT_EQ(make_swinir(file, config)->upscale(torch::rand({1, 3, 5, 7})).sizes(),
+            (std::vector<int64_t>{1, 3, 15, 21}));
+  const std::string message = error_message([&] { make_swinir(file, swinir_s_config(3)); });
+  EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+}
+
+TEST(SwinIR, RejectsAScaleOtherThanTheCheckpoints) {
+  const std::filesystem::path file = kData / "tiny_pixelshuffle_x2.pth";
+  const std::string message = error_message([&] { make_swinir(file, 4); });
+  EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("x2 SwinIR checkpoint, but x4"), std::string::npos) << message;
+}
+
+void expect_layout_rejected(const StateDict& weights, const std::string& problem) {
+  SCOPED_TRACE(problem);
+  const std::string message = error_message([&] { infer_swinir_config(weights, "odd.pth"); });
+  EXPECT_EQ(message.rfind("odd.pth: ", 0), 0u) << message;
+  EXPECT_NE(message.find(problem), std::string::npos) << message;
+}
+
+TEST(SwinIR, RejectsLayoutsItDoesNotRun) {
+  SwinIR net(swinir_s_config(2));
+  const StateDict official = layout_of(*net);
+  expect_layout_rejected({}, "no conv_first.weight");
+
+  StateDict real_world = official;
+  real_world["conv_up1.weight"] = torch::zeros({64, 64, 3, 3});
+  expect_layout_rejected(real_world, "'nearest+conv'");
+
+  StateDict three_conv = official;
+  three_conv.erase("conv_after_body.weight");
+  three_conv["conv_after_body.0.weight"] = torch::zeros({15, 60, 3, 3});
+  expect_layout_rejected(three_conv, "'3conv'");
+
+  StateDict denoiser = official;
+  denoiser.erase("upsample.0.weight");
+  expect_layout_rejected(denoiser, "without an upsampler");
+
+  StateDict flat_upsample = official;
+  flat_upsample["upsample.0.weight"] = torch::zeros({});
+  expect_layout_rejected(flat_upsample, "upsample.0.weight has 0 dimensions, not 4");
+
+  StateDict odd_heads = official;
+  odd_heads["layers.1.residual_group.blocks.0.attn.relative_position_bias_table"] =
+      torch::zeros({225, 7});
+  expect_layout_rejected(odd_heads, "7 heads do not divide the embedding width 60");
+
+  StateDict huge_window = official;
+  huge_window["layers.0.residual_group.blocks.0.attn.relative_position_bias_table"] =
+      torch::zeros({}).expand({199 * 199, 6});
+  expect_layout_rejected(huge_window, "window size 100 is outside");
+}
+
+TEST(SwinIR, UpscalesAnySizeByMirroringPastTheWindow) {
+  torch::manual_seed(0);
+  SwinIRConfig config = swinir_s_config(2);
+  config.embed_dim = 12;
+  config.depths = {2};
+  config.num_heads = {2};
+  SwinIRUpscaler upscaler{SwinIR(config)};
+  for (const auto& [height, width] : std::vector<std::pair<int, int>>{{1, 1}, {3, 17}, {8, 8}}) {
+    const torch::Tensor out = upscaler.upscale(torch::rand({1, 3, height, width}));
+    EXPECT_EQ(out.sizes(), (std::vector<int64_t>{1, 3, 2 * height, 2 * width}));
+    EXPECT_TRUE(out.isfinite().all().item<bool>());
+  }
+  const std::string message = error_message([&] { upscaler.upscale(torch::rand({1, 1, 8, 8})); });
+  EXPECT_NE(message.find("(B, 3, H, W)"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace iesrgs::priors::sr
