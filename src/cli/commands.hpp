@@ -12,5 +12,6 @@ void add_render_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
 void add_depth_command(CLI::App& app);
 void add_upscale_command(CLI::App& app);
+void add_external_command(CLI::App& app);
 
 }  // namespace iesrgs::cli

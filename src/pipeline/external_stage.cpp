@@ -1,0 +1,115 @@
+#include "pipeline/external_stage.hpp"
+
+#include <fmt/core.h>
+#include <torch/torch.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/image.hpp"
+#include "io/image_tensor.hpp"
+#include "priors/depth/depth_files.hpp"
+#include "priors/depth/depth_net.hpp"
+#include "priors/sr/registry.hpp"
+#include "priors/sr/sr_net.hpp"
+
+namespace iesrgs::pipeline {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Identity of a file without reading it: absolute path, size and modification time.
+std::string file_identity(const fs::path& path) {
+  if (path.empty() || !fs::exists(path)) return "-";
+  const auto stamp = fs::last_write_time(path).time_since_epoch().count();
+  return fmt::format("{}:{}:{}", fs::absolute(path).string(), fs::file_size(path), stamp);
+}
+
+// Everything one view's outputs depend on besides the view itself.
+std::string stage_identity(const ExternalOptions& o, const fs::path& sr_weights) {
+  return fmt::format("sr={} x{} tile={}/{} weights={} | depth={} weights={}", o.sr_model, o.scale,
+                     o.tiles.tile, o.tiles.overlap, file_identity(sr_weights), o.depth_model,
+                     file_identity(o.depth_weights));
+}
+
+std::string view_fingerprint(const std::string& stage, const Scene& scene, const Camera& camera) {
+  const std::string text =
+      fmt::format("{} | {} {}x{} /{} bg {},{},{}", stage, file_identity(camera.image_path),
+                  camera.intrinsics.width, camera.intrinsics.height, scene.downscale,
+                  scene.background[0], scene.background[1], scene.background[2]);
+  return fmt::format("{:016x}", std::hash<std::string>{}(text));
+}
+
+nlohmann::json read_record(const fs::path& path) {
+  if (!fs::exists(path)) return nlohmann::json::object();
+  nlohmann::json record = nlohmann::json::parse(read_file(path), nullptr, false);
+  // A damaged record only costs recomputation.
+  return record.is_object() ? record : nlohmann::json::object();
+}
+
+fs::path resolved_sr_weights(const ExternalOptions& options) {
+  if (!options.sr_weights.empty() || options.sr_model == "bicubic" ||
+      options.sr_model.rfind("esrgan", 0) == 0)
+    return options.sr_weights;
+  return priors::sr::default_sr_weights(options.sr_model, options.scale);
+}
+
+}  // namespace
+
+std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& images,
+                                             const ExternalOptions& options, const fs::path& dir) {
+  const fs::path sr_weights = resolved_sr_weights(options);
+  const std::string stage = stage_identity(options, sr_weights);
+  const fs::path record_path = dir / "external.json";
+  nlohmann::json record = read_record(record_path);
+  std::unique_ptr<priors::sr::SrNet> sr;  // loaded only when some view needs it
+  std::unique_ptr<priors::depth::DepthNet> depth;
+  bool loaded = false;
+
+  const std::vector<const Camera*> cameras = scene.split(Split::Train);
+  std::vector<ExternalView> views;
+  size_t computed = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    const Camera& camera = *cameras[i];
+    ExternalView view{
+        camera.name, dir / "image" / (camera.name + ".png"),
+        options.depth_model == "none" ? fs::path() : dir / "depth" / (camera.name + ".npy")};
+    views.push_back(view);
+    const std::string fingerprint = view_fingerprint(stage, scene, camera);
+    const bool cached = record.value(camera.name, "") == fingerprint && fs::exists(view.image) &&
+                        (view.depth.empty() || fs::exists(view.depth));
+    if (cached) continue;
+    if (!loaded) {
+      sr = priors::sr::make_sr_net(options.sr_model, options.sr_weights, options.scale);
+      depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights);
+      loaded = true;
+    }
+    const torch::Tensor upscaled =
+        priors::sr::upscale_tiled(*sr, to_tensor(*images.rgb(camera)), options.tiles);
+    write_png(view.image, to_image8(upscaled));
+    if (depth) {
+      // Depth of E_image as the model saw it: the 8-bit image written above.
+      const torch::Tensor seen = to_tensor(to_float(read_image8(view.image)));
+      priors::depth::write_depth_outputs(
+          depth->predict(seen),
+          {view.image, view.depth, dir / "depth" / (camera.name + "_preview.png")});
+    }
+    record[camera.name] = fingerprint;
+    write_file_atomically(record_path, record.dump(1) + "\n");
+    ++computed;
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fmt::print("external {}/{} {}: {:.2f} s per view\n", i + 1, cameras.size(), camera.name,
+               seconds / double(computed));
+    std::fflush(stdout);
+  }
+  fmt::print("external stage: {} views computed, {} reused from {}\n", computed,
+             cameras.size() - computed, dir.string());
+  return views;
+}
+
+}  // namespace iesrgs::pipeline

@@ -1,0 +1,38 @@
+#pragma once
+// Stage 1 of IE-SRGS, external knowledge: every training view's low-resolution image through a
+// pre-trained 2D super-resolution network (E_image), and E_image through a monocular depth
+// network (E_depth). Results are cached per view with a fingerprint of everything they depend
+// on, so a rerun recomputes only what changed and an interrupted run resumes.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "io/scene.hpp"
+#include "io/view_images.hpp"
+#include "priors/sr/tiling.hpp"
+
+namespace iesrgs::pipeline {
+
+struct ExternalOptions {
+  std::string sr_model = "safmn";
+  std::filesystem::path sr_weights;  // empty: the model's default location
+  int scale = 4;
+  priors::sr::TileOptions tiles{256, 32};
+  std::string depth_model = "none";  // "none" turns the external depth prior off
+  std::filesystem::path depth_weights;
+};
+
+struct ExternalView {
+  std::string name;
+  std::filesystem::path image;  // <dir>/image/<name>.png, E_image
+  std::filesystem::path depth;  // <dir>/depth/<name>.npy, E_depth; empty without a depth model
+};
+
+// Runs the stage for the training cameras of `scene` (the low-resolution input) into `dir`,
+// printing progress, and returns one entry per training view in scene order. The cache record is
+// <dir>/external.json, updated after every view.
+std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& images,
+                                             const ExternalOptions& options,
+                                             const std::filesystem::path& dir);
+
+}  // namespace iesrgs::pipeline
