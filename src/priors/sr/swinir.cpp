@@ -348,28 +348,27 @@ std::unique_ptr<SrNet> load_swinir(StateDict weights, const SwinIRConfig& config
   return std::make_unique<SwinIRUpscaler>(std::move(net));
 }
 
-}  // namespace
-
-SwinIRConfig swinir_m_config(int scale) {
+// The official classical-SR family: `layers` residual groups of 6 blocks with 6 heads each,
+// MLP ratio 2.
+SwinIRConfig official_config(int embed_dim, int layers, SwinIRUpsampler upsampler, int scale) {
   SwinIRConfig config;
-  config.embed_dim = 180;
-  config.depths.assign(6, 6);
-  config.num_heads.assign(6, 6);
-  config.mlp_hidden_dim = 2 * config.embed_dim;
-  config.upsampler = SwinIRUpsampler::PixelShuffle;
+  config.embed_dim = embed_dim;
+  config.depths.assign(size_t(layers), 6);
+  config.num_heads.assign(size_t(layers), 6);
+  config.mlp_hidden_dim = 2 * embed_dim;
+  config.upsampler = upsampler;
   config.scale = scale;
   return config;
 }
 
+}  // namespace
+
+SwinIRConfig swinir_m_config(int scale) {
+  return official_config(180, 6, SwinIRUpsampler::PixelShuffle, scale);
+}
+
 SwinIRConfig swinir_s_config(int scale) {
-  SwinIRConfig config;
-  config.embed_dim = 60;
-  config.depths.assign(4, 6);
-  config.num_heads.assign(4, 6);
-  config.mlp_hidden_dim = 2 * config.embed_dim;
-  config.upsampler = SwinIRUpsampler::PixelShuffleDirect;
-  config.scale = scale;
-  return config;
+  return official_config(60, 4, SwinIRUpsampler::PixelShuffleDirect, scale);
 }
 
 SwinIRConfig infer_swinir_config(const StateDict& weights, const std::filesystem::path& file) {
