@@ -1,5 +1,7 @@
 // iesrgs: low-resolution multi-view captures in, high-resolution 3D Gaussian Splatting out.
+#include <omp.h>
 #include <spdlog/spdlog.h>
+#include <torch/torch.h>
 
 #include <cstdio>
 #include <exception>
@@ -8,6 +10,9 @@
 
 int main(int argc, char** argv) {
   CLI::App app{"iesrgs: super-resolution 3D Gaussian Splatting (IE-SRGS) on CPUs and GPUs"};
+  // LibTorch's CPU ops (the networks) default to one thread here; give them the cores OpenMP
+  // uses for our own kernels (OMP_NUM_THREADS still limits both).
+  torch::set_num_threads(omp_get_max_threads());
   app.require_subcommand(1);
   app.set_version_flag("--version", "iesrgs 0.1.0");
   app.add_flag_callback(
