@@ -13,5 +13,6 @@ void add_eval_command(CLI::App& app);
 void add_depth_command(CLI::App& app);
 void add_upscale_command(CLI::App& app);
 void add_external_command(CLI::App& app);
+void add_run_command(CLI::App& app);
 
 }  // namespace iesrgs::cli

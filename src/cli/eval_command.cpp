@@ -9,8 +9,8 @@
 #include "core/error.hpp"
 #include "eval/lpips.hpp"
 #include "eval/metrics.hpp"
-#include "io/image_tensor.hpp"
 #include "io/view_images.hpp"
+#include "pipeline/evaluate.hpp"
 
 namespace iesrgs::cli {
 
@@ -25,22 +25,6 @@ struct EvalArgs {
   std::string background = "white";
   std::string lpips = "alex";
 };
-
-// LPIPS when its two checkpoints are at hand; otherwise the report says which file is missing.
-std::optional<eval::Lpips> load_lpips(const std::string& name, std::string& status) {
-  if (name == "none") {
-    status = "not computed (--lpips none)";
-    return std::nullopt;
-  }
-  const eval::LpipsNet net = eval::parse_lpips_net(name);
-  const eval::LpipsWeights weights = eval::default_lpips_weights(net);
-  if (const auto missing = eval::lpips_unavailable_reason(net, weights)) {
-    status = "unavailable: " + *missing;
-    return std::nullopt;
-  }
-  status = name;
-  return eval::Lpips::load(net, weights);
-}
 
 bool is_image(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -111,7 +95,8 @@ void run_eval(const EvalArgs& args) {
   scene_args.background = args.background;
   GroundTruth truth(args, scene_args.resolved());
   eval::MetricsReport report;
-  const std::optional<eval::Lpips> lpips = load_lpips(args.lpips, report.lpips_status);
+  const std::optional<eval::Lpips> lpips =
+      eval::load_default_lpips(args.lpips, report.lpips_status);
   const std::vector<std::filesystem::path> files = render_files(args.renders);
   for (size_t i = 0; i < files.size(); ++i) {
     const std::string name = files[i].stem().string();
@@ -119,10 +104,8 @@ void run_eval(const EvalArgs& args) {
     const Image reference = truth.get(name);
     if (render.channels != 3) fail_file(files[i], "is not an RGB image");
     try {
-      std::optional<double> perceptual;
-      if (lpips) perceptual = lpips->distance(to_tensor(render), to_tensor(reference));
       report.views.push_back(
-          {name, eval::psnr(render, reference), eval::ssim(render, reference), perceptual});
+          pipeline::measure_view(name, render, reference, lpips ? &*lpips : nullptr));
     } catch (const Error& e) {
       fail_file(files[i], e.what());
     }

@@ -1,6 +1,7 @@
 // iesrgs external: stage 1 of IE-SRGS alone (2D super-resolution and monocular depth of every
 // training view), cached and resumable.
 #include "cli/commands.hpp"
+#include "cli/external_options.hpp"
 #include "cli/scene_options.hpp"
 #include "pipeline/external_stage.hpp"
 
@@ -17,7 +18,9 @@ struct ExternalArgs {
 void run_external(const ExternalArgs& args) {
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   ViewImages images(scene);
-  pipeline::run_external_stage(scene, images, args.options, args.output);
+  pipeline::ExternalOptions options = args.options;
+  pipeline::resolve_sr_model(options);
+  pipeline::run_external_stage(scene, images, options, args.output);
 }
 
 }  // namespace
@@ -28,18 +31,8 @@ void add_external_command(CLI::App& app) {
       "external", "External knowledge: super-resolve (and estimate depth of) every training view");
   args->scene.add_to(*command);
   command->add_option("-o,--output", args->output, "Output folder (image/, depth/)")->required();
-  pipeline::ExternalOptions& o = args->options;
-  command->add_option("--sr-model", o.sr_model, "2D SR backend (see iesrgs upscale)")
-      ->capture_default_str();
-  command->add_option("--sr-weights", o.sr_weights, "SR checkpoint (default: the model's own)");
-  command->add_option("--scale", o.scale, "Upscaling factor s")->capture_default_str();
-  command->add_option("--tile", o.tiles.tile, "SR tile side in input pixels, 0 = whole image")
-      ->capture_default_str();
-  command
-      ->add_option("--depth-model", o.depth_model,
-                   "none, or depth-anything-v2[-vits|-vitb|-vitl] (needs --depth-weights)")
-      ->capture_default_str();
-  command->add_option("--depth-weights", o.depth_weights, "Depth Anything V2 checkpoint");
+  command->add_option("--scale", args->options.scale, "Upscaling factor s")->capture_default_str();
+  add_external_options(*command, args->options);
   command->callback([args] { run_external(*args); });
 }
 

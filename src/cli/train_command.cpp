@@ -66,7 +66,7 @@ void run_train(const TrainArgs& args) {
   ViewImages images(scene);
   train::TrainerSetup setup;
   setup.train_views = train::load_views(scene, Split::Train, images);
-  setup.test_views = train::load_views(scene, Split::Test, images);
+  setup.test_views = train::load_views(scene, Split::Test, images, size_t(config.test_views));
   setup.background = scene.background;
   setup.scene_extent = scene.normalization().radius;
   setup.output_dir = out;

@@ -61,4 +61,9 @@ class Lpips {
   std::shared_ptr<Networks> networks_;
 };
 
+// The metric from its default weights when "alex" or "vgg" names it and both files exist;
+// otherwise nullopt, with `status` saying why ("not computed" for "none", or the missing file).
+// On success `status` is the net's name.
+std::optional<Lpips> load_default_lpips(const std::string& name, std::string& status);
+
 }  // namespace iesrgs::eval

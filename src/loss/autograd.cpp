@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "loss/pearson.hpp"
 #include "loss/ssim.hpp"
+#include "loss/texture_fusion.hpp"
 
 namespace iesrgs::loss {
 namespace {
@@ -109,6 +110,33 @@ class PearsonFunction : public torch::autograd::Function<PearsonFunction> {
   }
 };
 
+class GuidedTextureFunction : public torch::autograd::Function<GuidedTextureFunction> {
+ public:
+  // An undefined `internal` travels as an empty tensor: autograd::Function takes defined ones.
+  static at::Tensor forward(AutogradContext* ctx, const at::Tensor& render_in,
+                            const at::Tensor& internal_in, const at::Tensor& external_in,
+                            const at::Tensor& share_in, double dssim_weight) {
+    const at::Tensor render = render_in.contiguous(), internal = internal_in.contiguous();
+    const at::Tensor external = external_in.contiguous(), share = share_in.contiguous();
+    const ImageShape shape = chw_shape(render);
+    at::Tensor grad = at::zeros_like(render);
+    const double loss = with_scalar_type(render, [&](auto zero) {
+      using T = decltype(zero);
+      return guided_texture_loss<T>(
+          render.data_ptr<T>(), internal.numel() ? internal.data_ptr<T>() : nullptr,
+          external.data_ptr<T>(), share.data_ptr<T>(), shape, dssim_weight, grad.data_ptr<T>());
+    });
+    // The loss is linear in its upstream gradient, so the full gradient is computed once here.
+    ctx->save_for_backward({grad});
+    return at::scalar_tensor(loss, render.options());
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const at::Tensor grad = ctx->get_saved_variables()[0] * grads[0];
+    return {grad, at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
+  }
+};
+
 }  // namespace
 
 SsimTensors ssim_autograd(const at::Tensor& x, const at::Tensor& y) {
@@ -124,6 +152,20 @@ at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b, const at::
          c10::str(mask.sizes()), c10::str(mask.device()));
   // autograd::Function takes defined tensors only.
   return PearsonFunction::apply(a, b, mask.defined() ? mask : at::ones(a.sizes(), at::kByte));
+}
+
+at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& internal,
+                                   const at::Tensor& external, const at::Tensor& internal_share,
+                                   double dssim_weight) {
+  check_pair("guided texture (external)", render, external);
+  if (internal.defined()) check_pair("guided texture (internal)", render, internal);
+  const auto expected = render.sizes().slice(1);
+  if (!internal_share.defined() || internal_share.sizes() != expected ||
+      internal_share.scalar_type() != render.scalar_type())
+    fail("guided texture: the internal share must be a {} map of the render's dtype",
+         c10::str(expected));
+  return GuidedTextureFunction::apply(render, internal.defined() ? internal : at::empty({0}),
+                                      external, internal_share, dssim_weight);
 }
 
 }  // namespace iesrgs::loss

@@ -20,4 +20,11 @@ SsimTensors ssim_autograd(const at::Tensor& x, const at::Tensor& y);
 at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b,
                             const at::Tensor& mask = at::Tensor());
 
+// The fusion stage's texture loss (loss/texture_fusion.hpp) of a render (C, H, W) against the
+// internal and external references, `internal_share` (H, W) choosing between them per pixel;
+// `internal` may be undefined when the share is zero everywhere. Differentiable in render.
+at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& internal,
+                                   const at::Tensor& external, const at::Tensor& internal_share,
+                                   double dssim_weight);
+
 }  // namespace iesrgs::loss

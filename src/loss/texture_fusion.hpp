@@ -13,18 +13,24 @@ namespace iesrgs::loss {
 constexpr double kDiscrepancyThresholdSynthetic = 0.6;
 constexpr double kDiscrepancyThresholdReal = 0.9;
 
-// M(p) = [D(p) >= threshold] with D(p) = mean over channels of |I - E| / (I + 1e-6), the ratio
-// taken per channel before averaging. One byte per pixel, 1 selects the internal image.
+// D(p) = mean over channels of |I - E| / (I + 1e-6), the ratio taken per channel before
+// averaging.
+template <typename T>
+std::vector<T> discrepancy_map(const T* internal, const T* external, const ImageShape& shape);
+
+// M(p) = [D(p) >= threshold], one byte per pixel; 1 selects the internal image.
 template <typename T>
 std::vector<uint8_t> discrepancy_mask(const T* internal, const T* external, const ImageShape& shape,
                                       double threshold);
 
-// L_tex = mean_p(M(p) * l_I(p) + (1 - M(p)) * l_E(p)), l_ref the photometric map
-// (1 - lambda) * l1_map + lambda * (1 - ssim_map) of the render against ref. Adds its gradient
-// with respect to the render to grad_render when non-null.
+// L_tex = mean_p(S(p) * l_I(p) + (1 - S(p)) * l_E(p)), l_ref the photometric map
+// (1 - lambda) * l1_map + lambda * (1 - ssim_map) of the render against ref, and S the internal
+// share per pixel: the mask M for IE-SRGS, 0.5 to average both references, 0 for E alone (then
+// `internal` may be null). A reference whose share is zero everywhere is not evaluated. Adds the
+// gradient with respect to the render to grad_render when non-null.
 template <typename T>
-double masked_texture_loss(const T* render, const T* internal, const T* external,
-                           const uint8_t* mask, const ImageShape& shape, double lambda,
+double guided_texture_loss(const T* render, const T* internal, const T* external,
+                           const T* internal_share, const ImageShape& shape, double lambda,
                            T* grad_render);
 
 }  // namespace iesrgs::loss

@@ -59,8 +59,15 @@ fs::path resolved_sr_weights(const ExternalOptions& options) {
 
 }  // namespace
 
+void resolve_sr_model(ExternalOptions& options) {
+  if (options.sr_model != "auto") return;
+  options.sr_model = priors::sr::auto_sr_model(options.scale);
+  fmt::print("SR prior: {} (--sr-model auto)\n", options.sr_model);
+}
+
 std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& images,
                                              const ExternalOptions& options, const fs::path& dir) {
+  if (options.sr_model == "auto") fail("run_external_stage: resolve the SR model first");
   const fs::path sr_weights = resolved_sr_weights(options);
   const std::string stage = stage_identity(options, sr_weights);
   const fs::path record_path = dir / "external.json";

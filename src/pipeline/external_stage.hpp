@@ -14,7 +14,7 @@
 namespace iesrgs::pipeline {
 
 struct ExternalOptions {
-  std::string sr_model = "safmn";
+  std::string sr_model = "auto";     // "auto": see resolve_sr_model
   std::filesystem::path sr_weights;  // empty: the model's default location
   int scale = 4;
   priors::sr::TileOptions tiles{256, 32};
@@ -27,6 +27,10 @@ struct ExternalView {
   std::filesystem::path image;  // <dir>/image/<name>.png, E_image
   std::filesystem::path depth;  // <dir>/depth/<name>.npy, E_depth; empty without a depth model
 };
+
+// Replaces "auto" by the best SR model at hand for the scale (priors::sr::auto_sr_model), saying
+// which.
+void resolve_sr_model(ExternalOptions& options);
 
 // Runs the stage for the training cameras of `scene` (the low-resolution input) into `dir`,
 // printing progress, and returns one entry per training view in scene order. The cache record is

@@ -2,16 +2,23 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 #include "core/error.hpp"
 #include "io/image_tensor.hpp"
 #include "io/ply.hpp"
 
 namespace iesrgs::train {
 
-std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images) {
+std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images,
+                                  size_t limit) {
+  const std::vector<const Camera*> cameras = scene.split(split);
+  const size_t count = limit == 0 ? cameras.size() : std::min(limit, cameras.size());
   std::vector<TrainView> views;
-  for (const Camera* camera : scene.split(split))
-    views.push_back({*camera, to_tensor(*images.rgb(*camera))[0]});
+  for (size_t i = 0; i < count; ++i) {
+    const Camera& camera = *cameras[i * cameras.size() / count];
+    views.push_back({camera, to_tensor(*images.rgb(camera))[0]});
+  }
   return views;
 }
 

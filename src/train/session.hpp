@@ -12,8 +12,10 @@
 
 namespace iesrgs::train {
 
-// Every camera of `split` with its decoded image, in scene order.
-std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images);
+// The cameras of `split` with their decoded images, in scene order: all of them, or `limit`
+// evenly spaced ones when limit is positive and smaller (the periodic test report needs few).
+std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images,
+                                  size_t limit = 0);
 
 // The starting model: `init_ply` when given, else SfM points when the scene has them and the
 // config allows, else config.random_points in a box of half-size config.random_extent.

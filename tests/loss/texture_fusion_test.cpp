@@ -40,8 +40,8 @@ struct Views {
   std::vector<double> external = random_values(shape.values(), 3, 0.5, 1.0);
 };
 
-double masked_loss(const Views& v, const std::vector<uint8_t>& mask, std::vector<double>* grad) {
-  return masked_texture_loss(v.render.data(), v.internal.data(), v.external.data(), mask.data(),
+double guided_loss(const Views& v, const std::vector<double>& share, std::vector<double>* grad) {
+  return guided_texture_loss(v.render.data(), v.internal.data(), v.external.data(), share.data(),
                              v.shape, kDssimWeight, grad ? grad->data() : nullptr);
 }
 
@@ -51,37 +51,57 @@ double photometric(const Views& v, const std::vector<double>& reference,
   return photometric_loss(v.render.data(), reference.data(), v.shape, kDssimWeight, grad->data());
 }
 
-TEST(MaskedTexture, MaskAllZeroUsesTheExternalImageAllOneTheInternal) {
+TEST(GuidedTexture, ShareZeroUsesTheExternalImageShareOneTheInternal) {
   const Views v;
-  for (uint8_t value : {0, 1}) {
-    const std::vector<uint8_t> mask(v.shape.pixels(), value);
+  for (double value : {0.0, 1.0}) {
+    const std::vector<double> share(v.shape.pixels(), value);
     std::vector<double> grad(v.shape.values(), 0.0), expected_grad = grad;
-    const double loss = masked_loss(v, mask, &grad);
+    const double loss = guided_loss(v, share, &grad);
     const double expected = photometric(v, value ? v.internal : v.external, &expected_grad);
     EXPECT_NEAR(loss, expected, 1e-12);
     for (size_t i = 0; i < grad.size(); ++i) EXPECT_NEAR(grad[i], expected_grad[i], 1e-12);
   }
 }
 
-TEST(MaskedTexture, RenderEqualToBothReferencesGivesZero) {
+TEST(GuidedTexture, HalfShareAveragesBothReferences) {
+  const Views v;
+  const std::vector<double> half(v.shape.pixels(), 0.5);
+  std::vector<double> unused(v.shape.values(), 0.0);
+  EXPECT_NEAR(guided_loss(v, half, nullptr),
+              0.5 * (photometric(v, v.internal, &unused) + photometric(v, v.external, &unused)),
+              1e-12);
+}
+
+TEST(GuidedTexture, ExternalAloneNeedsNoInternalImage) {
+  const Views v;
+  const std::vector<double> zero(v.shape.pixels(), 0.0);
+  std::vector<double> unused(v.shape.values(), 0.0);
+  EXPECT_NEAR(
+      guided_texture_loss(v.render.data(), static_cast<const double*>(nullptr), v.external.data(),
+                          zero.data(), v.shape, kDssimWeight, static_cast<double*>(nullptr)),
+      photometric(v, v.external, &unused), 1e-12);
+}
+
+TEST(GuidedTexture, RenderEqualToBothReferencesGivesZero) {
   const Views v;
   const std::vector<uint8_t> mask = discrepancy_mask(v.internal.data(), v.external.data(), v.shape,
                                                      kDiscrepancyThresholdSynthetic);
-  EXPECT_NEAR(masked_texture_loss(v.render.data(), v.render.data(), v.render.data(), mask.data(),
+  const std::vector<double> share(mask.begin(), mask.end());
+  EXPECT_NEAR(guided_texture_loss(v.render.data(), v.render.data(), v.render.data(), share.data(),
                                   v.shape, kDssimWeight, static_cast<double*>(nullptr)),
               0.0, 1e-12);
 }
 
-TEST(MaskedTexture, GradientMatchesFiniteDifferences) {
+TEST(GuidedTexture, GradientMatchesFiniteDifferences) {
   Views v;
-  std::vector<uint8_t> mask(v.shape.pixels());
-  for (size_t p = 0; p < mask.size(); ++p) mask[p] = (p * 7) % 3 == 0;
+  std::vector<double> share(v.shape.pixels());
+  for (size_t p = 0; p < share.size(); ++p) share[p] = (p * 7) % 3 == 0;
   std::vector<double> grad(v.shape.values(), 0.0);
-  masked_loss(v, mask, &grad);
+  guided_loss(v, share, &grad);
   const auto loss = [&](const std::vector<double>& render) {
     Views at = v;
     at.render = render;
-    return masked_loss(at, mask, nullptr);
+    return guided_loss(at, share, nullptr);
   };
   loss_testing::expect_gradient_near(grad, numeric_gradient(v.render, loss), 1e-4);
 }

@@ -9,9 +9,9 @@
 #include <map>
 
 #include "core/error.hpp"
+#include "io/image_tensor.hpp"
 #include "priors/sr/bicubic.hpp"
 #include "priors/sr/esrgan.hpp"
-#include "io/image_tensor.hpp"
 #include "priors/sr/imdn.hpp"
 #include "priors/sr/pan.hpp"
 #include "priors/sr/safmn.hpp"
@@ -145,6 +145,14 @@ std::unique_ptr<SrNet> make_sr_net(const std::string& model, const fs::path& wei
          fmt::join(sr_model_names(), ", "));
   if (scale < 1) fail("{}: invalid scale {}", model, scale);
   return found->second(weights, scale);
+}
+
+std::string auto_sr_model(int scale) {
+  if (fs::exists(default_sr_weights("safmn", scale))) return "safmn";
+  const fs::path esrgan =
+      default_esrgan_package_dir("slim") / "models" / fmt::format("x{}", scale) / "model.json";
+  if (fs::exists(esrgan)) return "esrgan-slim";
+  return "bicubic";
 }
 
 }  // namespace iesrgs::priors::sr

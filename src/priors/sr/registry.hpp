@@ -15,6 +15,10 @@ std::filesystem::path default_weights_dir();
 // SAFMN_x4.pth.
 std::filesystem::path default_sr_weights(const std::string& model, int scale);
 
+// The best prior at hand for `scale`, for "--sr-model auto": SAFMN when its checkpoint is at
+// the default location, else the installed ESRGAN (slim) package, else bicubic.
+std::string auto_sr_model(int scale);
+
 // The names make_sr_net accepts.
 const std::vector<std::string>& sr_model_names();
 

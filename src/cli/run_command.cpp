@@ -1,0 +1,131 @@
+// iesrgs run: the whole IE-SRGS pipeline with its baselines (and iesrgs internal / iesrgs fuse,
+// the same options running one stage): external knowledge, internal model and SR-splatting,
+// fusion training of the HR model, rendering and evaluation, each stage cached and resumable.
+#include <fmt/core.h>
+
+#include "cli/commands.hpp"
+#include "cli/external_options.hpp"
+#include "cli/scene_options.hpp"
+#include "pipeline/ie_srgs.hpp"
+#include "train/config.hpp"
+
+namespace iesrgs::cli {
+
+namespace {
+
+struct TrainingArgs {
+  std::string preset;
+  int64_t iterations = 0;
+  int views_per_iteration;
+  std::vector<std::string> assignments;
+
+  train::TrainConfig resolve(uint64_t seed) const {
+    train::TrainConfig config = train::make_preset(preset, iterations);
+    config.views_per_iteration = views_per_iteration;
+    config.seed = seed;
+    for (const std::string& assignment : assignments) train::apply_assignment(config, assignment);
+    train::validate(config);
+    return config;
+  }
+};
+
+struct RunArgs {
+  SceneArgs scene;
+  pipeline::RunOptions options;
+  std::string output;
+  TrainingArgs internal{"fast", 0, 3, {}};
+  TrainingArgs fusion{"fast", 0, 1, {}};
+  std::string texture = "masked";
+  std::vector<std::string> rows{"ie-srgs"};
+  uint64_t seed = 0;
+};
+
+void run_pipeline(const RunArgs& args, pipeline::StageSelection only) {
+  pipeline::RunOptions options = args.options;
+  options.scene = args.scene.path;
+  options.scene_options = args.scene.resolved();
+  options.output = args.output;
+  options.internal_config = args.internal.resolve(args.seed);
+  options.fusion_config = args.fusion.resolve(args.seed);
+  options.weights.texture = loss::parse_texture_guidance(args.texture);
+  options.rows = args.rows;
+  options.only = only;
+  pipeline::run_ie_srgs(options);
+}
+
+void add_training_options(CLI::App& command, TrainingArgs& args, const std::string& stage,
+                          const std::string& what) {
+  const std::string prefix = stage.empty() ? "--" : "--" + stage + "-";
+  command.add_option(prefix + "preset", args.preset, what + " schedule: paper, cpu, fast")
+      ->capture_default_str();
+  command.add_option(prefix + "iterations", args.iterations,
+                     what + " iterations; the preset's schedule is rescaled to fit");
+  command
+      .add_option(prefix + "mv", args.views_per_iteration,
+                  what + " views per iteration (multi-view regulation K)")
+      ->capture_default_str();
+  command.add_option(prefix + "set", args.assignments,
+                     what + " training parameter key=value (repeatable; see config.json)");
+}
+
+CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
+                               const std::string& description, pipeline::StageSelection only) {
+  auto args = std::make_shared<RunArgs>();
+  CLI::App* command = app.add_subcommand(name, description);
+  args->scene.add_to(*command);
+  pipeline::RunOptions& o = args->options;
+  command->add_option("-o,--output", args->output, "Run folder (stages, rows, results)")
+      ->required();
+  command->add_option("--scale", o.scale, "Super-resolution factor s")->capture_default_str();
+  command->add_flag("--input-is-lr", o.input_is_lr,
+                    "The scene's images are the LR input (no HR ground truth: render, no metrics)");
+  add_external_options(*command, o.external);
+  add_training_options(*command, args->internal, "internal", "Internal (LR) model");
+  add_training_options(*command, args->fusion, "", "HR model");
+  command
+      ->add_option("--texture", args->texture,
+                   "IE-SRGS texture guidance: masked, average, external or internal")
+      ->capture_default_str();
+  command->add_option("--li", o.weights.internal_depth, "Internal depth weight (0 = off)")
+      ->capture_default_str();
+  command->add_option("--le", o.weights.external_depth, "External depth weight (0 = off)")
+      ->capture_default_str();
+  command->add_option("--dssim", o.weights.dssim_weight, "D-SSIM weight l of the texture loss")
+      ->capture_default_str();
+  command->add_option("--threshold", o.threshold,
+                      "Discrepancy threshold T (default 0.6 synthetic, 0.9 real scenes)");
+  command->add_option("--init", o.init, "HR model start: scene (as 3DGS) or internal")
+      ->check(CLI::IsMember({"scene", "internal"}))
+      ->capture_default_str();
+  command
+      ->add_option("--rows", args->rows,
+                   "Comparison rows, comma-separated: " + pipeline::describe_rows())
+      ->delimiter(',')
+      ->capture_default_str();
+  command->add_option("--lpips", o.lpips, "LPIPS backbone: alex, vgg or none")
+      ->check(CLI::IsMember({"alex", "vgg", "none"}))
+      ->capture_default_str();
+  command
+      ->add_option("--diagnostic-views", o.diagnostic_views,
+                   "Training views in the diagnostics contact sheet")
+      ->capture_default_str();
+  command->add_option("--seed", args->seed, "Random seed of both trainings")->capture_default_str();
+  command->callback([args, only] { run_pipeline(*args, only); });
+  return command;
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app) {
+  add_pipeline_command(
+      app, "run", "IE-SRGS end to end: LR scene in, HR Gaussian scene, renders and metrics out",
+      pipeline::StageSelection::All);
+  add_pipeline_command(app, "internal",
+                       "IE-SRGS stage 2 alone: the LR model and its SR-splatting renders",
+                       pipeline::StageSelection::Internal);
+  add_pipeline_command(app, "fuse",
+                       "IE-SRGS stage 3 and 4 alone, from the cached external and internal stages",
+                       pipeline::StageSelection::Fusion);
+}
+
+}  // namespace iesrgs::cli

@@ -1,0 +1,119 @@
+#include "loss/fusion.hpp"
+
+#include <ATen/ATen.h>
+
+#include <vector>
+
+#include "core/error.hpp"
+#include "loss/autograd.hpp"
+#include "loss/texture_fusion.hpp"
+
+namespace iesrgs::loss {
+
+namespace {
+
+constexpr const char* kGuidanceNames[] = {"masked", "average", "external", "internal"};
+
+ImageShape chw_shape(const torch::Tensor& image) {
+  return {int(image.size(2)), int(image.size(1)), int(image.size(0))};
+}
+
+// A float (H, W) tensor holding its own copy of `values`.
+template <typename T>
+torch::Tensor map_tensor(const std::vector<T>& values, const ImageShape& shape,
+                         torch::ScalarType type) {
+  return torch::from_blob(const_cast<T*>(values.data()), {shape.height, shape.width}, type)
+      .clone()
+      .to(torch::kFloat);
+}
+
+// L1 between the render's expected depth and I_depth where both saw a surface.
+torch::Tensor internal_depth_loss(const raster::RenderOutput& render,
+                                  const torch::Tensor& internal_depth,
+                                  const torch::Tensor& covered) {
+  const torch::Tensor valid = covered & (internal_depth > 0);
+  if (!valid.any().item<bool>()) return torch::zeros({}, render.depth.options());
+  const torch::Tensor expected = render.depth / render.alpha.clamp_min(1e-6);
+  return (expected - internal_depth).abs().masked_select(valid).mean();
+}
+
+// 1 - corr(rendered inverse depth, E_depth) over the covered pixels, as SparseGS relaxes depth.
+torch::Tensor external_depth_loss(const raster::RenderOutput& render,
+                                  const torch::Tensor& disparity, const torch::Tensor& covered) {
+  const torch::Tensor inverse_depth = render.alpha / render.depth.clamp_min(1e-6);
+  return 1 - pearson_autograd(inverse_depth, disparity, covered);
+}
+
+}  // namespace
+
+TextureGuidance parse_texture_guidance(const std::string& name) {
+  for (int i = 0; i < 4; ++i)
+    if (name == kGuidanceNames[i]) return TextureGuidance(i);
+  fail("unknown texture guidance '{}' (masked, average, external or internal)", name);
+}
+
+const char* texture_guidance_name(TextureGuidance guidance) {
+  return kGuidanceNames[int(guidance)];
+}
+
+torch::Tensor discrepancy(const torch::Tensor& internal_image,
+                          const torch::Tensor& external_image) {
+  const torch::Tensor internal = internal_image.contiguous(),
+                      external = external_image.contiguous();
+  const ImageShape shape = chw_shape(internal);
+  return map_tensor(discrepancy_map(internal.data_ptr<float>(), external.data_ptr<float>(), shape),
+                    shape, torch::kFloat);
+}
+
+torch::Tensor internal_share(TextureGuidance guidance, const torch::Tensor& internal_image,
+                             const torch::Tensor& external_image, double threshold) {
+  const torch::Tensor& reference = external_image.defined() ? external_image : internal_image;
+  const auto options = reference.options();
+  const int64_t height = reference.size(1), width = reference.size(2);
+  switch (guidance) {
+    case TextureGuidance::Masked: {
+      const torch::Tensor internal = internal_image.contiguous();
+      const torch::Tensor external = external_image.contiguous();
+      const ImageShape shape = chw_shape(internal);
+      return map_tensor(discrepancy_mask(internal.data_ptr<float>(), external.data_ptr<float>(),
+                                         shape, threshold),
+                        shape, torch::kUInt8);
+    }
+    case TextureGuidance::Average:
+      return torch::full({height, width}, 0.5, options);
+    case TextureGuidance::External:
+      return torch::zeros({height, width}, options);
+    case TextureGuidance::Internal:
+      return torch::ones({height, width}, options);
+  }
+  fail("internal_share: invalid guidance");
+}
+
+FusionLossTerms fusion_loss(const raster::RenderOutput& render, const FusionTargets& targets,
+                            const FusionWeights& weights) {
+  const bool uses_internal = weights.texture != TextureGuidance::External;
+  const torch::Tensor& external =
+      targets.external_image.defined() ? targets.external_image : targets.internal_image;
+  FusionLossTerms terms;
+  terms.total = guided_texture_autograd(render.image,
+                                        uses_internal ? targets.internal_image : torch::Tensor(),
+                                        external, targets.internal_share, weights.dssim_weight);
+  terms.texture = terms.total.item<double>();
+  const bool internal_depth = weights.internal_depth > 0 && targets.internal_depth.defined();
+  const bool external_depth = weights.external_depth > 0 && targets.external_disparity.defined();
+  if (!internal_depth && !external_depth) return terms;
+  const torch::Tensor covered = render.alpha.detach() >= kDepthCoverageAlpha;
+  if (internal_depth) {
+    const torch::Tensor l = internal_depth_loss(render, targets.internal_depth, covered);
+    terms.internal_depth = l.item<double>();
+    terms.total = terms.total + weights.internal_depth * l;
+  }
+  if (external_depth) {
+    const torch::Tensor l = external_depth_loss(render, targets.external_disparity, covered);
+    terms.external_depth = l.item<double>();
+    terms.total = terms.total + weights.external_depth * l;
+  }
+  return terms;
+}
+
+}  // namespace iesrgs::loss

@@ -1,0 +1,37 @@
+#include "pipeline/evaluate.hpp"
+
+#include <fmt/core.h>
+
+#include <optional>
+
+#include "io/image.hpp"
+#include "io/image_tensor.hpp"
+#include "pipeline/render_views.hpp"
+
+namespace iesrgs::pipeline {
+
+eval::ViewMetrics measure_view(const std::string& name, const Image& render, const Image& reference,
+                               const eval::Lpips* lpips) {
+  std::optional<double> perceptual;
+  if (lpips) perceptual = lpips->distance(to_tensor(render), to_tensor(reference));
+  return {name, eval::psnr(render, reference), eval::ssim(render, reference), perceptual};
+}
+
+Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector<Camera>& cameras,
+                               const std::array<float, 3>& background, ViewImages* truth,
+                               const std::string& lpips, const std::filesystem::path& dir) {
+  Evaluation evaluation;
+  evaluation.seconds_per_view = render_views_to(dir, model, cameras, background, 1.0);
+  if (!truth) return evaluation;
+  eval::MetricsReport& report = evaluation.report;
+  const std::optional<eval::Lpips> metric = eval::load_default_lpips(lpips, report.lpips_status);
+  for (const Camera& camera : cameras) {
+    const Image render = to_float(read_image8(dir / "rgb" / (camera.name + ".png")));
+    report.views.push_back(
+        measure_view(camera.name, render, *truth->rgb(camera), metric ? &*metric : nullptr));
+  }
+  eval::write_report(dir / "metrics", report);
+  return evaluation;
+}
+
+}  // namespace iesrgs::pipeline

@@ -1,0 +1,32 @@
+#pragma once
+// Stage 4: render the test views at HR and score the 8-bit renders, as written to disk, against
+// the ground truth (PSNR, SSIM, and LPIPS when its weights are at hand).
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "eval/lpips.hpp"
+#include "eval/metrics.hpp"
+#include "gs/model.hpp"
+#include "io/view_images.hpp"
+
+namespace iesrgs::pipeline {
+
+// Scores of one render against its reference (both RGB of the same size); LPIPS when given.
+eval::ViewMetrics measure_view(const std::string& name, const Image& render, const Image& reference,
+                               const eval::Lpips* lpips);
+
+struct Evaluation {
+  eval::MetricsReport report;   // empty without ground truth
+  double seconds_per_view = 0;  // rendering alone
+};
+
+// Renders `cameras` into <dir>/{rgb,depth,alpha}; with `truth`, scores every render against
+// truth->rgb(camera) and writes <dir>/metrics.json and .csv. `lpips` as in
+// eval::load_default_lpips.
+Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector<Camera>& cameras,
+                               const std::array<float, 3>& background, ViewImages* truth,
+                               const std::string& lpips, const std::filesystem::path& dir);
+
+}  // namespace iesrgs::pipeline

@@ -1,0 +1,422 @@
+#include "pipeline/ie_srgs.hpp"
+
+#include <fmt/core.h>
+
+#include <chrono>
+#include <memory>
+#include <optional>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/image_tensor.hpp"
+#include "io/view_images.hpp"
+#include "loss/texture_fusion.hpp"
+#include "pipeline/diagnostics.hpp"
+#include "pipeline/evaluate.hpp"
+#include "pipeline/fusion_stage.hpp"
+#include "pipeline/internal_stage.hpp"
+#include "pipeline/render_views.hpp"
+#include "train/progress.hpp"
+#include "train/session.hpp"
+
+namespace iesrgs::pipeline {
+
+namespace {
+
+namespace fs = std::filesystem;
+using loss::TextureGuidance;
+
+// What supervises a row's HR model.
+enum class Source {
+  Internal,       // no HR model: the internal LR model itself, rendered at HR
+  SuperResolved,  // the external (and internal) knowledge
+  Bicubic,        // bicubic-upsampled LR views
+  HighRes,        // the HR ground truth (upper bound)
+};
+
+struct RowSpec {
+  const char* id;
+  const char* label;
+  Source source;
+  TextureGuidance texture;
+  bool internal_depth, external_depth;
+};
+
+constexpr RowSpec kRows[] = {
+    {"bicubic", "bicubic-3DGS", Source::Bicubic, TextureGuidance::External, false, false},
+    {"internal", "internal only (LR Mip-Splatting at HR)", Source::Internal,
+     TextureGuidance::External, false, false},
+    {"external", "external only (2D SR -> 3DGS)", Source::SuperResolved, TextureGuidance::External,
+     false, false},
+    {"external-depth", "+ E_depth", Source::SuperResolved, TextureGuidance::External, false, true},
+    {"joint", "+ I_image (averaged, no mask)", Source::SuperResolved, TextureGuidance::Average,
+     false, true},
+    {"joint-depth", "+ I_depth", Source::SuperResolved, TextureGuidance::Average, true, true},
+    {"ie-srgs", "IE-SRGS (+ mask)", Source::SuperResolved, TextureGuidance::Masked, true, true},
+    {"hr", "HR upper bound", Source::HighRes, TextureGuidance::External, false, false},
+};
+
+const RowSpec& row_spec(const std::string& id) {
+  for (const RowSpec& row : kRows)
+    if (id == row.id) return row;
+  fail("unknown row '{}'; rows: {}", id, describe_rows());
+}
+
+double elapsed_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+class Pipeline {
+ public:
+  explicit Pipeline(const RunOptions& options);
+  RunResult run();
+
+ private:
+  bool any_row(Source source) const;
+  bool rows_use_internal_references() const;
+  void check_cached_inputs() const;
+  void run_external_stages();
+  void run_internal_stage();
+  std::vector<Camera> hr_train_cameras() const;
+  std::vector<Camera> test_cameras() const;
+  loss::FusionWeights row_weights(const RowSpec& row) const;
+  FusionSetup fusion_setup(const RowSpec& row, const loss::FusionWeights& weights) const;
+  nlohmann::json row_params(const RowSpec& row, const loss::FusionWeights& weights) const;
+  gs::GaussianModel initial_hr_model() const;
+  RowResult evaluate_row(const RowSpec& row, const gs::GaussianModel& model, const fs::path& dir);
+  RowResult run_fusion_row(const RowSpec& row);
+  void write_fusion_diagnostics(const gs::GaussianModel& model, const FusionSetup& setup) const;
+
+  RunOptions o_;
+  std::vector<std::string> rows_;
+  Scene lr_scene_;
+  std::optional<Scene> hr_scene_;
+  std::unique_ptr<ViewImages> lr_images_, hr_images_;
+  double threshold_;
+  std::vector<ExternalView> external_, bicubic_;
+  std::optional<InternalStage> internal_;
+  nlohmann::json stages_ = nlohmann::json::object();
+};
+
+Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(options.rows)) {
+  if (o_.scale < 2) fail("--scale must be at least 2, got {}", o_.scale);
+  o_.external.scale = o_.scale;
+  if (any_row(Source::SuperResolved)) resolve_sr_model(o_.external);
+  SceneOptions lr_options = o_.scene_options;
+  if (!o_.input_is_lr) {
+    hr_scene_ = load_scene(o_.scene, o_.scene_options);
+    hr_images_ = std::make_unique<ViewImages>(*hr_scene_);
+    lr_options.downscale *= o_.scale;
+  }
+  lr_scene_ = load_scene(o_.scene, lr_options);
+  lr_images_ = std::make_unique<ViewImages>(lr_scene_);
+  threshold_ = o_.threshold >= 0     ? o_.threshold
+               : lr_scene_.synthetic ? loss::kDiscrepancyThresholdSynthetic
+                                     : loss::kDiscrepancyThresholdReal;
+  if (o_.input_is_lr && any_row(Source::HighRes))
+    fail("the hr row needs HR images, which a low-resolution input (--input-is-lr) lacks");
+}
+
+bool Pipeline::any_row(Source source) const {
+  for (const std::string& id : rows_)
+    if (row_spec(id).source == source) return true;
+  return false;
+}
+
+bool Pipeline::rows_use_internal_references() const {
+  if (o_.init == "internal") return true;
+  for (const std::string& id : rows_) {
+    const RowSpec& row = row_spec(id);
+    const loss::FusionWeights weights = row_weights(row);
+    if (row.source == Source::Internal || weights.texture != TextureGuidance::External ||
+        weights.internal_depth > 0)
+      return true;
+  }
+  return false;
+}
+
+void Pipeline::check_cached_inputs() const {
+  const auto require = [](const fs::path& record, const char* stage, const char* command) {
+    if (!fs::exists(record))
+      fail_file(record, fmt::format("missing: the {} stage has not run here (iesrgs {} or iesrgs "
+                                    "run with the same scene and options runs it)",
+                                    stage, command));
+  };
+  if (any_row(Source::SuperResolved))
+    require(o_.output / "external" / "external.json", "external", "run");
+  if (rows_use_internal_references())
+    require(o_.output / "internal" / "stage.json", "internal", "internal");
+}
+
+void Pipeline::run_external_stages() {
+  const auto start = std::chrono::steady_clock::now();
+  ExternalOptions options = o_.external;
+  if (any_row(Source::SuperResolved))
+    external_ = run_external_stage(lr_scene_, *lr_images_, options, o_.output / "external");
+  if (any_row(Source::Bicubic)) {
+    options.sr_model = "bicubic";
+    options.sr_weights.clear();
+    options.depth_model = "none";
+    bicubic_ = run_external_stage(lr_scene_, *lr_images_, options, o_.output / "bicubic");
+  }
+  stages_["external_seconds"] = elapsed_since(start);
+}
+
+void Pipeline::run_internal_stage() {
+  internal_ = pipeline::run_internal_stage(lr_scene_, *lr_images_, o_.internal_config, o_.scale,
+                                           o_.output / "internal");
+  stages_["internal_training_seconds"] = internal_->training.seconds;
+  stages_["sr_splatting_seconds"] = stage_seconds(internal_->sr_dir);
+}
+
+std::vector<Camera> Pipeline::hr_train_cameras() const {
+  std::vector<Camera> cameras;
+  for (const Camera* camera : lr_scene_.split(Split::Train))
+    cameras.push_back(camera->scaled(o_.scale));
+  return cameras;
+}
+
+std::vector<Camera> Pipeline::test_cameras() const {
+  std::vector<Camera> cameras;
+  if (hr_scene_) {
+    for (const Camera* camera : hr_scene_->split(Split::Test)) cameras.push_back(*camera);
+  } else {
+    for (const Camera* camera : lr_scene_.split(Split::Test))
+      cameras.push_back(camera->scaled(o_.scale));
+  }
+  return cameras;
+}
+
+loss::FusionWeights Pipeline::row_weights(const RowSpec& row) const {
+  loss::FusionWeights weights = o_.weights;
+  if (std::string(row.id) != "ie-srgs") {
+    weights.texture = row.texture;
+    if (!row.internal_depth) weights.internal_depth = 0;
+    if (!row.external_depth) weights.external_depth = 0;
+  }
+  if (o_.external.depth_model == "none") weights.external_depth = 0;
+  return weights;
+}
+
+FusionSetup Pipeline::fusion_setup(const RowSpec& row, const loss::FusionWeights& weights) const {
+  FusionSetup setup;
+  setup.weights = weights;
+  setup.background = lr_scene_.background;
+  setup.scene_extent = lr_scene_.normalization().radius;
+  if (hr_scene_)
+    setup.test_views = train::load_views(*hr_scene_, Split::Test, *hr_images_,
+                                         size_t(o_.fusion_config.test_views));
+  if (row.source == Source::HighRes) {
+    for (const Camera* camera : hr_scene_->split(Split::Train)) {
+      setup.cameras.push_back(*camera);
+      loss::FusionTargets targets;
+      targets.external_image = to_tensor(*hr_images_->rgb(*camera))[0];
+      targets.internal_share =
+          loss::internal_share(TextureGuidance::External, {}, targets.external_image, 0);
+      setup.targets.push_back(std::move(targets));
+    }
+    return setup;
+  }
+  setup.cameras = hr_train_cameras();
+  const std::vector<ExternalView>& external = row.source == Source::Bicubic ? bicubic_ : external_;
+  for (size_t i = 0; i < setup.cameras.size(); ++i) {
+    const std::string& name = setup.cameras[i].name;
+    ReferenceFiles files{external[i].image, external[i].depth, {}, {}};
+    if (internal_) {
+      files.internal_image = internal_->sr_dir / "rgb" / (name + ".png");
+      files.internal_depth = internal_->sr_dir / "depth" / (name + ".npy");
+    }
+    setup.targets.push_back(load_fusion_targets(files, setup.cameras[i], weights, threshold_));
+  }
+  return setup;
+}
+
+nlohmann::json Pipeline::row_params(const RowSpec& row, const loss::FusionWeights& weights) const {
+  nlohmann::json params = {{"row", row.id},
+                           {"scene", lr_scene_.root.string()},
+                           {"lr_downscale", lr_scene_.downscale},
+                           {"scale", o_.scale},
+                           {"texture", loss::texture_guidance_name(weights.texture)},
+                           {"dssim_weight", weights.dssim_weight},
+                           {"internal_depth", weights.internal_depth},
+                           {"external_depth", weights.external_depth},
+                           {"threshold", threshold_},
+                           {"init", o_.init}};
+  if (row.source == Source::SuperResolved)
+    params["external"] = {{"sr_model", o_.external.sr_model},
+                          {"sr_weights", o_.external.sr_weights.string()},
+                          {"depth_model", o_.external.depth_model},
+                          {"depth_weights", o_.external.depth_weights.string()}};
+  if (internal_) params["internal_model_seconds"] = internal_->training.seconds;
+  return params;
+}
+
+gs::GaussianModel Pipeline::initial_hr_model() const {
+  if (o_.init == "internal") {
+    gs::GaussianModel model = internal_->training.model;
+    model.active_sh_degree = 0;  // the HR schedule raises the SH degree again
+    return model;
+  }
+  return train::initial_model(hr_scene_ ? *hr_scene_ : lr_scene_, o_.fusion_config, {});
+}
+
+RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& model,
+                                 const fs::path& dir) {
+  const auto start = std::chrono::steady_clock::now();
+  const Evaluation evaluation = render_and_evaluate(model, test_cameras(), lr_scene_.background,
+                                                    hr_images_.get(), o_.lpips, dir / "test");
+  stages_["evaluation_seconds"][row.id] = elapsed_since(start);
+  RowResult result;
+  result.id = row.id;
+  result.label = row.label;
+  result.evaluated = !evaluation.report.views.empty();
+  if (result.evaluated) result.mean = evaluation.report.mean();
+  result.fps = evaluation.seconds_per_view > 0 ? 1 / evaluation.seconds_per_view : 0;
+  return result;
+}
+
+RowResult Pipeline::run_fusion_row(const RowSpec& row) {
+  const loss::FusionWeights weights = row_weights(row);
+  const fs::path dir = o_.output / "rows" / row.id;
+  fmt::print("\n== row {}: {} ==\n", row.id, row.label);
+  FusionSetup setup = fusion_setup(row, weights);
+  const FusionSetup diagnostics_setup = std::string(row.id) == "ie-srgs" ? setup : FusionSetup{};
+  const StageResult stage =
+      run_fusion_stage(std::move(setup), o_.fusion_config, row_params(row, weights), dir,
+                       [this] { return initial_hr_model(); });
+  stages_["fusion_seconds"][row.id] = stage.seconds;
+  if (!diagnostics_setup.cameras.empty()) write_fusion_diagnostics(stage.model, diagnostics_setup);
+  RowResult result = evaluate_row(row, stage.model, dir);
+  result.train_seconds = stage.seconds;
+  return result;
+}
+
+void Pipeline::write_fusion_diagnostics(const gs::GaussianModel& model,
+                                        const FusionSetup& setup) const {
+  std::vector<DiagnosticView> views;
+  const size_t count = std::min(setup.cameras.size(), size_t(std::max(o_.diagnostic_views, 0)));
+  for (size_t k = 0; k < count; ++k) {
+    const size_t i = k * setup.cameras.size() / count;
+    const Camera& camera = setup.cameras[i];
+    const RenderedView render = render_view(model, camera, setup.background);
+    DiagnosticView view{camera.name,
+                        setup.targets[i].external_image,
+                        setup.targets[i].internal_image,
+                        render.image,
+                        render.depth,
+                        {}};
+    if (hr_scene_) {
+      const Camera& truth_camera = *hr_scene_->split(Split::Train)[i];
+      if (truth_camera.intrinsics.width == camera.intrinsics.width &&
+          truth_camera.intrinsics.height == camera.intrinsics.height)
+        view.truth = to_tensor(*hr_images_->rgb(truth_camera))[0];
+    }
+    views.push_back(std::move(view));
+  }
+  write_diagnostics(o_.output / "diagnostics", views, threshold_);
+}
+
+RunResult Pipeline::run() {
+  const auto start = std::chrono::steady_clock::now();
+  if (o_.only == StageSelection::Fusion) check_cached_inputs();
+  if (o_.only != StageSelection::Internal) run_external_stages();
+  if (o_.only == StageSelection::External) return {{}, stages_};
+  if (rows_use_internal_references() || o_.only == StageSelection::Internal) run_internal_stage();
+  if (o_.only == StageSelection::Internal) return {{}, stages_};
+
+  RunResult result;
+  for (const std::string& id : rows_) {
+    const RowSpec& row = row_spec(id);
+    if (row.source != Source::Internal) {
+      result.rows.push_back(run_fusion_row(row));
+      continue;
+    }
+    fmt::print("\n== row {}: {} ==\n", row.id, row.label);
+    RowResult internal = evaluate_row(row, internal_->training.model, o_.output / "rows" / row.id);
+    internal.train_seconds = internal_->training.seconds;
+    result.rows.push_back(internal);
+  }
+  stages_["total_seconds_this_run"] = elapsed_since(start);
+  result.stages = stages_;
+  return result;
+}
+
+std::string format_metric(const RowResult& row, double value, int decimals) {
+  return row.evaluated ? fmt::format("{:.{}f}", value, decimals) : "-";
+}
+
+std::string results_markdown(const RunResult& result) {
+  std::string md =
+      "| row | PSNR | SSIM | LPIPS | HR training | FPS at HR |\n|---|---|---|---|---|---|\n";
+  for (const RowResult& row : result.rows)
+    md += fmt::format("| {} | {} | {} | {} | {} | {:.1f} |\n", row.label,
+                      format_metric(row, row.mean.psnr, 2), format_metric(row, row.mean.ssim, 4),
+                      row.mean.lpips ? fmt::format("{:.4f}", *row.mean.lpips) : "-",
+                      train::format_duration(row.train_seconds), row.fps);
+  return md;
+}
+
+void write_results(const fs::path& dir, const RunResult& result) {
+  nlohmann::json json = {{"stages", result.stages}, {"rows", nlohmann::json::array()}};
+  std::string csv = "row,label,psnr,ssim,lpips,train_seconds,fps\n";
+  for (const RowResult& row : result.rows) {
+    nlohmann::json entry = {{"row", row.id},
+                            {"label", row.label},
+                            {"train_seconds", row.train_seconds},
+                            {"fps", row.fps}};
+    if (row.evaluated) {
+      entry["psnr"] = row.mean.psnr;
+      entry["ssim"] = row.mean.ssim;
+      if (row.mean.lpips) entry["lpips"] = *row.mean.lpips;
+    }
+    json["rows"].push_back(entry);
+    csv += fmt::format("{},\"{}\",{},{},{},{},{}\n", row.id, row.label,
+                       format_metric(row, row.mean.psnr, 4), format_metric(row, row.mean.ssim, 5),
+                       row.mean.lpips ? fmt::format("{:.5f}", *row.mean.lpips) : "",
+                       row.train_seconds, row.fps);
+  }
+  write_file_atomically(dir / "results.json", json.dump(2) + "\n");
+  write_file_atomically(dir / "results.csv", csv);
+  write_file_atomically(dir / "results.md", results_markdown(result));
+}
+
+}  // namespace
+
+std::vector<std::string> expand_rows(const std::vector<std::string>& names) {
+  std::vector<bool> wanted(std::size(kRows), false);
+  for (const std::string& name : names) {
+    for (size_t i = 0; i < std::size(kRows); ++i) {
+      const std::string id = kRows[i].id;
+      const bool ablation = id != "bicubic" && id != "hr";
+      const bool demo = id == "bicubic" || id == "internal" || id == "external" || id == "ie-srgs";
+      if (name == id || name == "all" || (name == "ablation" && ablation) ||
+          (name == "demo" && demo))
+        wanted[i] = true;
+    }
+    if (name != "all" && name != "ablation" && name != "demo") row_spec(name);  // validates
+  }
+  std::vector<std::string> rows;
+  for (size_t i = 0; i < std::size(kRows); ++i)
+    if (wanted[i]) rows.push_back(kRows[i].id);
+  if (rows.empty()) fail("--rows: no row selected");
+  return rows;
+}
+
+std::string describe_rows() {
+  std::string text;
+  for (const RowSpec& row : kRows)
+    text += fmt::format("{}{} ({})", text.empty() ? "" : ", ", row.id, row.label);
+  return text + "; groups: demo, ablation, all";
+}
+
+RunResult run_ie_srgs(const RunOptions& options) {
+  Pipeline pipeline(options);
+  RunResult result = pipeline.run();
+  if (result.rows.empty()) return result;
+  write_results(options.output, result);
+  fmt::print("\n{}\nwrote {}\n", results_markdown(result),
+             (options.output / "results.md").string());
+  return result;
+}
+
+}  // namespace iesrgs::pipeline

@@ -1,0 +1,47 @@
+#include "pipeline/internal_stage.hpp"
+
+#include <fmt/core.h>
+
+#include <chrono>
+
+#include "pipeline/render_views.hpp"
+#include "train/session.hpp"
+
+namespace iesrgs::pipeline {
+
+InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
+                                 const train::TrainConfig& config, int scale,
+                                 const std::filesystem::path& dir) {
+  train::TrainerSetup setup;
+  setup.train_views = train::load_views(lr_scene, Split::Train, lr_images);
+  setup.test_views = train::load_views(lr_scene, Split::Test, lr_images, size_t(config.test_views));
+  setup.background = lr_scene.background;
+  setup.scene_extent = lr_scene.normalization().radius;
+  setup.output_dir = dir;
+  const nlohmann::json params = {{"scene", lr_scene.root.string()},
+                                 {"downscale", lr_scene.downscale}};
+  const train::TrainConfig& c = config;
+  fmt::print("internal model: {} LR views ({}x{}), K = {}, {} iterations\n",
+             setup.train_views.size(), setup.train_views.front().camera.intrinsics.width,
+             setup.train_views.front().camera.intrinsics.height, c.views_per_iteration,
+             c.iterations);
+  std::vector<Camera> cameras;
+  for (const train::TrainView& view : setup.train_views) cameras.push_back(view.camera);
+
+  InternalStage stage{
+      run_training_stage("internal model", params, config, std::move(setup),
+                         [&] { return train::initial_model(lr_scene, config, {}); }),
+      dir / "sr"};
+  // A finished training's recorded time tells which model the renders came from.
+  const nlohmann::json sr_params = {{"model_seconds", stage.training.seconds}, {"scale", scale}};
+  if (stage.training.cached && stage_finished(stage.sr_dir, sr_params)) return stage;
+  fmt::print("SR-splatting: rendering {} training views at x{}\n", cameras.size(), scale);
+  const auto start = std::chrono::steady_clock::now();
+  render_views_to(stage.sr_dir, stage.training.model, cameras, lr_scene.background, scale);
+  stage.sr_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  record_stage(stage.sr_dir, sr_params, true, stage.sr_seconds);
+  return stage;
+}
+
+}  // namespace iesrgs::pipeline

@@ -1,0 +1,27 @@
+#pragma once
+// Stage 2 of IE-SRGS, internal knowledge: a Mip-Splatting model trained on the low-resolution
+// views with multi-view regulation, then SR-splatting: every training view rendered from it at s
+// times the resolution with the same field of view (I_image, I_depth).
+#include <filesystem>
+
+#include "io/scene.hpp"
+#include "io/view_images.hpp"
+#include "pipeline/training_stage.hpp"
+#include "train/config.hpp"
+
+namespace iesrgs::pipeline {
+
+struct InternalStage {
+  StageResult training;
+  std::filesystem::path sr_dir;  // <dir>/sr: rgb/<name>.png (I_image), depth/<name>.npy (I_depth)
+  double sr_seconds = 0;         // SR-splatting time (0 when reused)
+};
+
+// Trains in <dir> (cached and resumable, see training_stage.hpp) on lr_scene's training views,
+// reporting PSNR on a few of its test views, then renders the SR-splatting outputs into <dir>/sr
+// unless an earlier run left them for the same model and scale.
+InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
+                                 const train::TrainConfig& config, int scale,
+                                 const std::filesystem::path& dir);
+
+}  // namespace iesrgs::pipeline

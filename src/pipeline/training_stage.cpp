@@ -1,0 +1,71 @@
+#include "pipeline/training_stage.hpp"
+
+#include <fmt/core.h>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/ply.hpp"
+#include "train/progress.hpp"
+#include "train/session.hpp"
+
+namespace iesrgs::pipeline {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+nlohmann::json read_record(const fs::path& dir) {
+  const fs::path path = dir / "stage.json";
+  if (!fs::exists(path)) return nlohmann::json::object();
+  nlohmann::json record = nlohmann::json::parse(read_file(path), nullptr, false);
+  return record.is_object() ? record : nlohmann::json::object();  // damaged: recompute
+}
+
+}  // namespace
+
+bool stage_finished(const fs::path& dir, const nlohmann::json& params) {
+  const nlohmann::json record = read_record(dir);
+  return record.value("finished", false) && record.value("params", nlohmann::json()) == params;
+}
+
+double stage_seconds(const fs::path& dir) {
+  return read_record(dir).value("seconds", 0.0);
+}
+
+void record_stage(const fs::path& dir, const nlohmann::json& params, bool finished,
+                  double seconds) {
+  const nlohmann::json record = {{"params", params}, {"finished", finished}, {"seconds", seconds}};
+  write_file_atomically(dir / "stage.json", record.dump(2) + "\n");
+}
+
+StageResult run_training_stage(const std::string& name, const nlohmann::json& params,
+                               const train::TrainConfig& config, train::TrainerSetup setup,
+                               const std::function<gs::GaussianModel()>& initial_model) {
+  const fs::path dir = setup.output_dir;
+  const nlohmann::json identity = {{"stage", params}, {"training", train::to_json(config)}};
+  if (stage_finished(dir, identity)) {
+    fmt::print("{}: reusing the finished model in {}\n", name, dir.string());
+    return {gs::model_from_splat_cloud(read_ply(dir / "point_cloud.ply")), stage_seconds(dir),
+            true};
+  }
+  const bool resumable = read_record(dir).value("params", nlohmann::json()) == identity &&
+                         fs::exists(dir / "checkpoint.pt");
+  if (!resumable) fs::remove(dir / "train_log.csv");
+  record_stage(dir, identity, false, 0);
+  train::Trainer trainer(config, std::move(setup), initial_model());
+  if (resumable) {
+    fmt::print("{}: resuming from {}\n", name, trainer.checkpoint_path().string());
+    trainer.resume();
+  }
+  const train::TrainSummary summary = trainer.run();
+  if (summary.interrupted)
+    fail("{} interrupted at iteration {}; run the same command again to resume", name,
+         summary.iterations);
+  train::write_point_clouds(dir, trainer.model());
+  record_stage(dir, identity, true, summary.seconds);
+  fmt::print("{}: {} Gaussians after {} ({:.2f} it/s)\n", name, summary.gaussians,
+             train::format_duration(summary.seconds), summary.iterations_per_second);
+  return {trainer.model(), summary.seconds, false};
+}
+
+}  // namespace iesrgs::pipeline

@@ -1,0 +1,114 @@
+#include "loss/fusion.hpp"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include "core/error.hpp"
+#include "loss/autograd.hpp"
+
+namespace iesrgs::loss {
+namespace {
+
+constexpr int64_t kHeight = 12, kWidth = 14;
+
+torch::Tensor random_image(uint64_t seed, double low = 0.2, double high = 0.9) {
+  torch::manual_seed(seed);
+  return low + (high - low) * torch::rand({3, kHeight, kWidth});
+}
+
+// A render whose depth and alpha are known: expected depth `depth` where alpha is 1, nothing drawn
+// (alpha 0) in the left columns.
+raster::RenderOutput render_with_depth(const torch::Tensor& depth, int uncovered_columns) {
+  raster::RenderOutput render;
+  render.image = random_image(7).requires_grad_();
+  torch::Tensor alpha = torch::ones({kHeight, kWidth});
+  alpha.narrow(1, 0, uncovered_columns).zero_();
+  render.alpha = alpha;
+  render.depth = (depth * alpha).requires_grad_();
+  return render;
+}
+
+TEST(FusionLoss, ExternalTextureIsThePhotometricLossAgainstE) {
+  raster::RenderOutput render;
+  render.image = random_image(1).requires_grad_();
+  FusionTargets targets;
+  targets.external_image = random_image(2);
+  targets.internal_share = internal_share(TextureGuidance::External, {}, targets.external_image, 0);
+  const FusionWeights weights{TextureGuidance::External, 0.2, 0, 0};
+  const torch::Tensor loss = fusion_loss(render, targets, weights).total;
+  loss.backward();
+  const torch::Tensor grad = render.image.grad().clone();
+
+  render.image.mutable_grad() = torch::Tensor();
+  const torch::Tensor expected =
+      0.8 * (render.image - targets.external_image).abs().mean() +
+      0.2 * (1 - ssim_autograd(render.image, targets.external_image).mean);
+  expected.backward();
+  EXPECT_NEAR(loss.item<double>(), expected.item<double>(), 1e-6);
+  EXPECT_TRUE(torch::allclose(grad, render.image.grad(), 1e-5, 1e-7));
+}
+
+TEST(FusionLoss, MaskedShareIsTheDiscrepancyMaskAndOthersAreConstant) {
+  const torch::Tensor internal = random_image(3), external = random_image(4);
+  const torch::Tensor d = discrepancy(internal, external);
+  const torch::Tensor expected_d = ((internal - external).abs() / (internal + 1e-6)).mean(0);
+  EXPECT_TRUE(torch::allclose(d, expected_d, 1e-5, 1e-6));
+  const torch::Tensor mask = internal_share(TextureGuidance::Masked, internal, external, 0.3);
+  EXPECT_TRUE(torch::equal(mask, (expected_d >= 0.3).to(torch::kFloat)));
+  EXPECT_GT(mask.sum().item<double>(), 0);
+  EXPECT_LT(mask.sum().item<double>(), double(kHeight * kWidth));
+  EXPECT_TRUE(torch::all(internal_share(TextureGuidance::Average, internal, external, 0) == 0.5)
+                  .item<bool>());
+  EXPECT_TRUE(torch::all(internal_share(TextureGuidance::Internal, internal, external, 0) == 1)
+                  .item<bool>());
+}
+
+TEST(FusionLoss, DepthTermsVanishForMatchingGeometryAndIgnoreUncoveredPixels) {
+  const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
+  raster::RenderOutput render = render_with_depth(depth, 3);
+  FusionTargets targets;
+  targets.external_image = random_image(5);
+  targets.internal_share = torch::zeros({kHeight, kWidth});
+  targets.internal_depth = depth.clone();
+  // Disparity up to an affine map is perfectly correlated; garbage where nothing is drawn.
+  targets.external_disparity = 3 / depth + 0.5;
+  targets.internal_depth.narrow(1, 0, 3).fill_(100);
+  targets.external_disparity.narrow(1, 0, 3).fill_(-7);
+  const FusionLossTerms terms =
+      fusion_loss(render, targets, {TextureGuidance::External, 0.2, 1e-3, 1e-4});
+  EXPECT_NEAR(terms.internal_depth, 0, 1e-5);
+  EXPECT_NEAR(terms.external_depth, 0, 1e-5);
+}
+
+TEST(FusionLoss, DepthTermsPullTheRenderedDepthTowardsTheReferences) {
+  const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
+  raster::RenderOutput render = render_with_depth(depth, 0);
+  FusionTargets targets;
+  targets.external_image = random_image(6);
+  targets.internal_share = torch::zeros({kHeight, kWidth});
+  targets.internal_depth = depth + 0.5;  // everything farther
+  torch::manual_seed(3);
+  targets.external_disparity = torch::rand({kHeight, kWidth});
+  const FusionLossTerms terms =
+      fusion_loss(render, targets, {TextureGuidance::External, 0.2, 1e-3, 1e-4});
+  EXPECT_NEAR(terms.internal_depth, 0.5, 1e-5);
+  EXPECT_GT(terms.external_depth, 0.1);
+  terms.total.backward();
+  // The internal term alone would push every rendered depth up (negative gradient).
+  EXPECT_TRUE(render.depth.grad().defined());
+  EXPECT_GT(render.depth.grad().abs().sum().item<double>(), 0);
+}
+
+TEST(FusionLoss, MissingReferenceOrUnknownGuidanceIsAnError) {
+  EXPECT_THROW(parse_texture_guidance("mixed"), Error);
+  EXPECT_EQ(parse_texture_guidance("average"), TextureGuidance::Average);
+  raster::RenderOutput render;
+  render.image = random_image(1).requires_grad_();
+  FusionTargets targets;
+  targets.external_image = random_image(2);
+  targets.internal_share = torch::ones({kHeight, kWidth});  // asks for the absent internal image
+  EXPECT_THROW(fusion_loss(render, targets, {TextureGuidance::Masked, 0.2, 0, 0}), Error);
+}
+
+}  // namespace
+}  // namespace iesrgs::loss
