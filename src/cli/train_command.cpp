@@ -64,12 +64,7 @@ void run_train(const TrainArgs& args) {
 
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   ViewImages images(scene);
-  train::TrainerSetup setup;
-  setup.train_views = train::load_views(scene, Split::Train, images);
-  setup.test_views = train::load_views(scene, Split::Test, images, size_t(config.test_views));
-  setup.background = scene.background;
-  setup.scene_extent = scene.normalization().radius;
-  setup.output_dir = out;
+  train::TrainerSetup setup = train::scene_setup(scene, images, size_t(config.test_views), out);
   const int width = setup.train_views.front().camera.intrinsics.width;
   const int height = setup.train_views.front().camera.intrinsics.height;
   fmt::print("training on {} views ({}x{}), {} test views; preset {}, {} iterations, K = {}\n",

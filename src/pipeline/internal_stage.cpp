@@ -12,12 +12,8 @@ namespace iesrgs::pipeline {
 InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
                                  const train::TrainConfig& config, int scale,
                                  const std::filesystem::path& dir) {
-  train::TrainerSetup setup;
-  setup.train_views = train::load_views(lr_scene, Split::Train, lr_images);
-  setup.test_views = train::load_views(lr_scene, Split::Test, lr_images, size_t(config.test_views));
-  setup.background = lr_scene.background;
-  setup.scene_extent = lr_scene.normalization().radius;
-  setup.output_dir = dir;
+  train::TrainerSetup setup =
+      train::scene_setup(lr_scene, lr_images, size_t(config.test_views), dir);
   const nlohmann::json params = {{"scene", lr_scene.root.string()},
                                  {"downscale", lr_scene.downscale}};
   const train::TrainConfig& c = config;

@@ -22,6 +22,17 @@ std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& i
   return views;
 }
 
+TrainerSetup scene_setup(const Scene& scene, ViewImages& images, size_t test_views,
+                         const std::filesystem::path& output_dir) {
+  TrainerSetup setup;
+  setup.train_views = load_views(scene, Split::Train, images);
+  setup.test_views = load_views(scene, Split::Test, images, test_views);
+  setup.background = scene.background;
+  setup.scene_extent = scene.normalization().radius;
+  setup.output_dir = output_dir;
+  return setup;
+}
+
 gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
                                 const std::filesystem::path& init_ply) {
   if (!init_ply.empty()) {

@@ -17,6 +17,11 @@ namespace iesrgs::train {
 std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images,
                                   size_t limit = 0);
 
+// Training on `scene`'s training views, reporting PSNR on `test_views` evenly spaced test views
+// (0: all), with checkpoints and logs in output_dir.
+TrainerSetup scene_setup(const Scene& scene, ViewImages& images, size_t test_views,
+                         const std::filesystem::path& output_dir);
+
 // The starting model: `init_ply` when given, else SfM points when the scene has them and the
 // config allows, else config.random_points in a box of half-size config.random_extent.
 gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,

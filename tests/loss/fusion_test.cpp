@@ -28,6 +28,16 @@ raster::RenderOutput render_with_depth(const torch::Tensor& depth, int uncovered
   return render;
 }
 
+// Targets with an external image only, for the depth-term tests to add their references to.
+FusionTargets external_targets(uint64_t seed) {
+  FusionTargets targets;
+  targets.external_image = random_image(seed);
+  targets.internal_share = torch::zeros({kHeight, kWidth});
+  return targets;
+}
+
+const FusionWeights kDepthWeights{TextureGuidance::External, 0.2, 1e-3, 1e-4};
+
 TEST(FusionLoss, ExternalTextureIsThePhotometricLossAgainstE) {
   raster::RenderOutput render;
   render.image = random_image(1).requires_grad_();
@@ -66,16 +76,13 @@ TEST(FusionLoss, MaskedShareIsTheDiscrepancyMaskAndOthersAreConstant) {
 TEST(FusionLoss, DepthTermsVanishForMatchingGeometryAndIgnoreUncoveredPixels) {
   const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
   raster::RenderOutput render = render_with_depth(depth, 3);
-  FusionTargets targets;
-  targets.external_image = random_image(5);
-  targets.internal_share = torch::zeros({kHeight, kWidth});
+  FusionTargets targets = external_targets(5);
   targets.internal_depth = depth.clone();
   // Disparity up to an affine map is perfectly correlated; garbage where nothing is drawn.
   targets.external_disparity = 3 / depth + 0.5;
   targets.internal_depth.narrow(1, 0, 3).fill_(100);
   targets.external_disparity.narrow(1, 0, 3).fill_(-7);
-  const FusionLossTerms terms =
-      fusion_loss(render, targets, {TextureGuidance::External, 0.2, 1e-3, 1e-4});
+  const FusionLossTerms terms = fusion_loss(render, targets, kDepthWeights);
   EXPECT_NEAR(terms.internal_depth, 0, 1e-5);
   EXPECT_NEAR(terms.external_depth, 0, 1e-5);
 }
@@ -83,14 +90,11 @@ TEST(FusionLoss, DepthTermsVanishForMatchingGeometryAndIgnoreUncoveredPixels) {
 TEST(FusionLoss, DepthTermsPullTheRenderedDepthTowardsTheReferences) {
   const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
   raster::RenderOutput render = render_with_depth(depth, 0);
-  FusionTargets targets;
-  targets.external_image = random_image(6);
-  targets.internal_share = torch::zeros({kHeight, kWidth});
+  FusionTargets targets = external_targets(6);
   targets.internal_depth = depth + 0.5;  // everything farther
   torch::manual_seed(3);
   targets.external_disparity = torch::rand({kHeight, kWidth});
-  const FusionLossTerms terms =
-      fusion_loss(render, targets, {TextureGuidance::External, 0.2, 1e-3, 1e-4});
+  const FusionLossTerms terms = fusion_loss(render, targets, kDepthWeights);
   EXPECT_NEAR(terms.internal_depth, 0.5, 1e-5);
   EXPECT_GT(terms.external_depth, 0.1);
   terms.total.backward();
