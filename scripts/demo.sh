@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-demo}"
-scripts/setup.sh
+scripts/setup.sh --cli
 build/iesrgs synth -o "$out/scene" --size 128 --views 40 --test-views 10 --seed 1
 # A short CPU schedule, and fewer random starting points than 3DGS's 100k for a scene this small.
 build/iesrgs run "$out/scene" -o "$out/run" --scale 4 --rows demo --lpips none \

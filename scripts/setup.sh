@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages iesrgs needs (only the missing ones), then configures and builds.
 #   scripts/setup.sh            release build in build/
+#   scripts/setup.sh --cli      the same, the iesrgs binary only (no tests, no benchmarks)
 #   scripts/setup.sh --asan     AddressSanitizer + UBSan build in build-asan/
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,10 +37,13 @@ fi
 
 build_dir=build
 options=(-DCMAKE_BUILD_TYPE=Release)
-if [ "${1:-}" = "--asan" ]; then
-  build_dir=build-asan
-  options=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DIESRGS_SANITIZE=ON -DIESRGS_BENCH=OFF)
-fi
+targets=()
+case "${1:-}" in
+  --asan)
+    build_dir=build-asan
+    options=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DIESRGS_SANITIZE=ON -DIESRGS_BENCH=OFF) ;;
+  --cli) targets=(--target iesrgs) ;;
+esac
 cmake -S . -B "$build_dir" "${options[@]}" >/dev/null
-cmake --build "$build_dir" -j "$(nproc)"
+cmake --build "$build_dir" -j "$(nproc)" "${targets[@]}"
 echo "setup: built $build_dir/iesrgs"
