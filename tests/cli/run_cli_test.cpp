@@ -77,5 +77,22 @@ TEST(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_FALSE(std::filesystem::exists(dir / "run" / "results.json"));
 }
 
+TEST(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 5 --test-views 1 --seed 3").status, 0);
+  const CliRun run = iesrgs("run " + scene + " -o " + out + " --input-is-lr" + kTinySchedule);
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_EQ(read_image_header(dir / "run" / "rows/ie-srgs/test/rgb/r_0.png").width, 64);
+  EXPECT_FALSE(std::filesystem::exists(dir / "run" / "rows/ie-srgs/test/metrics.json"));
+  const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+  EXPECT_FALSE(results["rows"][0].contains("psnr"));
+
+  const CliRun hr =
+      iesrgs("run " + scene + " -o " + out + " --input-is-lr --rows hr" + kTinySchedule);
+  EXPECT_EQ(hr.status, 1);
+  EXPECT_TRUE(contains(last_line(hr.output), "needs HR images")) << hr.output;
+}
+
 }  // namespace
 }  // namespace iesrgs
