@@ -12,6 +12,17 @@
 #include "loss/texture_fusion.hpp"
 
 namespace iesrgs::loss {
+
+ImageShape chw_shape(const at::Tensor& image, const char* what) {
+  constexpr int64_t kMaxSide = std::numeric_limits<int>::max();
+  if (image.dim() != 3 || image.size(0) > kMaxSide || image.size(1) > kMaxSide ||
+      image.size(2) > kMaxSide)
+    fail("{}: image shape {} is not (C, H, W)", what, c10::str(image.sizes()));
+  const ImageShape shape{int(image.size(2)), int(image.size(1)), int(image.size(0))};
+  check_shape(shape, what);
+  return shape;
+}
+
 namespace {
 
 using torch::autograd::AutogradContext;
@@ -38,22 +49,12 @@ void check_pair(const char* what, const at::Tensor& value, const at::Tensor& tar
   if (target.requires_grad()) fail("{}: the target must not require grad", what);
 }
 
-ImageShape chw_shape(const at::Tensor& image) {
-  constexpr int64_t kMaxSide = std::numeric_limits<int>::max();
-  if (image.dim() != 3 || image.size(0) > kMaxSide || image.size(1) > kMaxSide ||
-      image.size(2) > kMaxSide)
-    fail("ssim: image shape {} is not (C, H, W)", c10::str(image.sizes()));
-  const ImageShape shape{int(image.size(2)), int(image.size(1)), int(image.size(0))};
-  check_shape(shape, "ssim");
-  return shape;
-}
-
 class SsimFunction : public torch::autograd::Function<SsimFunction> {
  public:
   static variable_list forward(AutogradContext* ctx, const at::Tensor& x_in,
                                const at::Tensor& y_in) {
     const at::Tensor x = x_in.contiguous(), y = y_in.contiguous();
-    const ImageShape shape = chw_shape(x);
+    const ImageShape shape = chw_shape(x, "ssim");
     at::Tensor map = at::empty({shape.height, shape.width}, x.options());
     at::Tensor partials = at::empty({int64_t(ssim_partials_size(shape))}, x.options());
     const double mean = with_scalar_type(x, [&](auto zero) {
@@ -69,7 +70,7 @@ class SsimFunction : public torch::autograd::Function<SsimFunction> {
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const variable_list saved = ctx->get_saved_variables();
     const at::Tensor &x = saved[0], &y = saved[1], &partials = saved[2];
-    const ImageShape shape = chw_shape(x);
+    const ImageShape shape = chw_shape(x, "ssim");
     // d mean / d map[p] = 1 / pixels.
     const at::Tensor weight = (grads[1] + grads[0] / double(shape.pixels())).contiguous();
     at::Tensor grad_x = at::zeros_like(x);
@@ -118,7 +119,7 @@ class GuidedTextureFunction : public torch::autograd::Function<GuidedTextureFunc
                             const at::Tensor& share_in, double dssim_weight) {
     const at::Tensor render = render_in.contiguous(), internal = internal_in.contiguous();
     const at::Tensor external = external_in.contiguous(), share = share_in.contiguous();
-    const ImageShape shape = chw_shape(render);
+    const ImageShape shape = chw_shape(render, "guided texture loss");
     at::Tensor grad = at::zeros_like(render);
     const double loss = with_scalar_type(render, [&](auto zero) {
       using T = decltype(zero);

@@ -4,7 +4,12 @@
 // target (passing one that requires grad is an error).
 #include <ATen/core/Tensor.h>
 
+#include "loss/image_shape.hpp"
+
 namespace iesrgs::loss {
+
+// The shape of a (C, H, W) image tensor; throws Error("<what>: ...") for any other shape.
+ImageShape chw_shape(const at::Tensor& image, const char* what);
 
 struct SsimTensors {
   at::Tensor mean;  // scalar SSIM

@@ -14,10 +14,6 @@ namespace {
 
 constexpr const char* kGuidanceNames[] = {"masked", "average", "external", "internal"};
 
-ImageShape chw_shape(const torch::Tensor& image) {
-  return {int(image.size(2)), int(image.size(1)), int(image.size(0))};
-}
-
 // A float (H, W) tensor holding its own copy of `values`.
 template <typename T>
 torch::Tensor map_tensor(const std::vector<T>& values, const ImageShape& shape,
@@ -60,7 +56,7 @@ torch::Tensor discrepancy(const torch::Tensor& internal_image,
                           const torch::Tensor& external_image) {
   const torch::Tensor internal = internal_image.contiguous(),
                       external = external_image.contiguous();
-  const ImageShape shape = chw_shape(internal);
+  const ImageShape shape = chw_shape(internal, "fusion");
   return map_tensor(discrepancy_map(internal.data_ptr<float>(), external.data_ptr<float>(), shape),
                     shape, torch::kFloat);
 }
@@ -74,7 +70,7 @@ torch::Tensor internal_share(TextureGuidance guidance, const torch::Tensor& inte
     case TextureGuidance::Masked: {
       const torch::Tensor internal = internal_image.contiguous();
       const torch::Tensor external = external_image.contiguous();
-      const ImageShape shape = chw_shape(internal);
+      const ImageShape shape = chw_shape(internal, "fusion");
       return map_tensor(discrepancy_mask(internal.data_ptr<float>(), external.data_ptr<float>(),
                                          shape, threshold),
                         shape, torch::kUInt8);

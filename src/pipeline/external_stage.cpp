@@ -10,6 +10,7 @@
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
+#include "pipeline/stage_record.hpp"
 #include "priors/depth/depth_files.hpp"
 #include "priors/depth/depth_net.hpp"
 #include "priors/sr/registry.hpp"
@@ -43,13 +44,6 @@ std::string view_fingerprint(const std::string& stage, const Scene& scene, const
   return fmt::format("{:016x}", std::hash<std::string>{}(text));
 }
 
-nlohmann::json read_record(const fs::path& path) {
-  if (!fs::exists(path)) return nlohmann::json::object();
-  nlohmann::json record = nlohmann::json::parse(read_file(path), nullptr, false);
-  // A damaged record only costs recomputation.
-  return record.is_object() ? record : nlohmann::json::object();
-}
-
 fs::path resolved_sr_weights(const ExternalOptions& options) {
   if (!options.sr_weights.empty() || options.sr_model == "bicubic" ||
       options.sr_model.rfind("esrgan", 0) == 0)
@@ -71,7 +65,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
   const fs::path sr_weights = resolved_sr_weights(options);
   const std::string stage = stage_identity(options, sr_weights);
   const fs::path record_path = dir / "external.json";
-  nlohmann::json record = read_record(record_path);
+  nlohmann::json record = read_stage_record(record_path);
   std::unique_ptr<priors::sr::SrNet> sr;  // loaded only when some view needs it
   std::unique_ptr<priors::depth::DepthNet> depth;
   bool loaded = false;

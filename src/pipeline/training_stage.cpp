@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/ply.hpp"
+#include "pipeline/stage_record.hpp"
 #include "train/progress.hpp"
 #include "train/session.hpp"
 
@@ -14,22 +15,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-nlohmann::json read_record(const fs::path& dir) {
-  const fs::path path = dir / "stage.json";
-  if (!fs::exists(path)) return nlohmann::json::object();
-  nlohmann::json record = nlohmann::json::parse(read_file(path), nullptr, false);
-  return record.is_object() ? record : nlohmann::json::object();  // damaged: recompute
+nlohmann::json stage_json(const fs::path& dir) {
+  return read_stage_record(dir / "stage.json");
 }
 
 }  // namespace
 
 bool stage_finished(const fs::path& dir, const nlohmann::json& params) {
-  const nlohmann::json record = read_record(dir);
+  const nlohmann::json record = stage_json(dir);
   return record.value("finished", false) && record.value("params", nlohmann::json()) == params;
 }
 
 double stage_seconds(const fs::path& dir) {
-  return read_record(dir).value("seconds", 0.0);
+  return stage_json(dir).value("seconds", 0.0);
 }
 
 void record_stage(const fs::path& dir, const nlohmann::json& params, bool finished,
@@ -48,7 +46,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
     return {gs::model_from_splat_cloud(read_ply(dir / "point_cloud.ply")), stage_seconds(dir),
             true};
   }
-  const bool resumable = read_record(dir).value("params", nlohmann::json()) == identity &&
+  const bool resumable = stage_json(dir).value("params", nlohmann::json()) == identity &&
                          fs::exists(dir / "checkpoint.pt");
   if (!resumable) fs::remove(dir / "train_log.csv");
   record_stage(dir, identity, false, 0);

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "gs/neighbors.hpp"
+#include "gs/random_model.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -100,10 +101,9 @@ TEST(GaussianModel, RandomBoxMatchesNerfSyntheticDefault) {
                            model_from_random_box(10, 1.f, 7).means));
 }
 
-GaussianModel random_model(int64_t n) {
-  GaussianModel m;
-  m.set_params({torch::randn({n, 3}), torch::randn({n, 1, 3}), torch::randn({n, 15, 3}),
-                torch::randn({n}), torch::randn({n, 3}), torch::randn({n, 4})});
+// With a 3D filter and a lowered SH degree, which the PLY keeps and drops respectively.
+GaussianModel filtered_model(int64_t n) {
+  GaussianModel m = random_model(n);
   m.filter_3d = torch::rand({n});
   m.active_sh_degree = 2;
   return m;
@@ -111,7 +111,7 @@ GaussianModel random_model(int64_t n) {
 
 TEST(GaussianModel, SavesAsPlyAndLoadsBackExactly) {
   testing::TempDir dir;
-  const GaussianModel m = random_model(37);
+  const GaussianModel m = filtered_model(37);
   write_ply(dir / "m.ply", to_splat_cloud(m));
   const GaussianModel back = model_from_splat_cloud(read_ply(dir / "m.ply"));
   for (int p = 0; p < kParamCount; ++p)
@@ -121,7 +121,7 @@ TEST(GaussianModel, SavesAsPlyAndLoadsBackExactly) {
 }
 
 TEST(GaussianModel, LowerDegreeCloudsGetZeroHigherBands) {
-  SplatCloud cloud = to_splat_cloud(random_model(5));
+  SplatCloud cloud = to_splat_cloud(filtered_model(5));
   cloud.sh_degree = 1;
   cloud.sh_rest.resize(5 * 3 * 3);
   cloud.filter_3d.clear();
@@ -137,7 +137,7 @@ TEST(GaussianModel, LowerDegreeCloudsGetZeroHigherBands) {
 }
 
 TEST(GaussianModel, RenderTensorsJoinTheShBands) {
-  const GaussianModel m = random_model(3);
+  const GaussianModel m = filtered_model(3);
   const raster::GaussianTensors t = m.render_tensors();
   EXPECT_EQ(t.sh.sizes(), (c10::IntArrayRef{3, 16, 3}));
   EXPECT_TRUE(torch::equal(t.sh.narrow(1, 0, 1), m.sh_dc));

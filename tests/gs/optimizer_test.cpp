@@ -7,19 +7,13 @@
 
 #include "gs/checkpoint.hpp"
 #include "gs/densify.hpp"
+#include "gs/random_model.hpp"
 #include "raster/raster_test_scene.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs::gs {
 namespace {
-
-GaussianModel random_model(int64_t n) {
-  GaussianModel m;
-  m.set_params({torch::randn({n, 3}), torch::randn({n, 1, 3}), torch::randn({n, 15, 3}),
-                torch::randn({n}), torch::randn({n, 3}), torch::randn({n, 4})});
-  return m;
-}
 
 void set_random_grads(GaussianModel& m) {
   for (int p = 0; p < kParamCount; ++p)

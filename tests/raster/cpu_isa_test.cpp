@@ -57,15 +57,6 @@ Differentiated<T> render_and_differentiate(Isa isa, const Scene<T>& s, const Cam
   return d;
 }
 
-template <typename T>
-double max_abs_diff(const std::vector<T>& a, const std::vector<T>& b) {
-  EXPECT_EQ(a.size(), b.size());
-  double worst = 0;
-  for (size_t i = 0; i < std::min(a.size(), b.size()); ++i)
-    worst = std::max(worst, std::abs(double(a[i]) - double(b[i])));
-  return worst;
-}
-
 // Largest difference relative to the largest magnitude of the group: single gradients of nearly
 // cancelling terms have no meaningful relative error of their own.
 template <typename T>

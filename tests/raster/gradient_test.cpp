@@ -10,7 +10,7 @@
 namespace iesrgs::raster::testkit {
 namespace {
 
-const double kBackground[3] = {0.3, 0.6, 0.1};
+const double kGradientBackground[3] = {0.3, 0.6, 0.1};
 
 // Finite differences render thousands of tiny frames: one thread avoids OpenMP start-up costs,
 // which dominate on a busy machine.
@@ -82,9 +82,9 @@ Gradients backward(const Scene<double>& s, KernelRender<double>& r, const Linear
 void check_every_group(const Camera& cam, Scene<double> s, unsigned seed) {
   const SingleThread single_thread;
   const LinearLoss loss(size_t(cam.intrinsics.width) * cam.intrinsics.height, seed);
-  KernelRender<double> r = kernel_render(s, cam, kBackground);
+  KernelRender<double> r = kernel_render(s, cam, kGradientBackground);
   const Gradients g = backward(s, r, loss);
-  const auto evaluate = [&] { return loss(kernel_render(s, cam, kBackground)); };
+  const auto evaluate = [&] { return loss(kernel_render(s, cam, kGradientBackground)); };
   EXPECT_LT(group_error(s.means, g.means, evaluate), 1e-2) << "means";
   EXPECT_LT(group_error(s.log_scales, g.log_scales, evaluate), 1e-2) << "log-scales";
   EXPECT_LT(group_error(s.quats, g.quats, evaluate), 1e-2) << "quaternions";
@@ -132,7 +132,7 @@ TEST(RasterBackward, SplatGradientsMatchFiniteDifferences) {
   const Camera cam = posed_test_camera(40, 36);
   const Scene<double> s = random_scene(cam, 20, 2, 9);
   const LinearLoss loss(size_t(40) * 36, 13);
-  KernelRender<double> r = kernel_render(s, cam, kBackground);
+  KernelRender<double> r = kernel_render(s, cam, kGradientBackground);
   const Gradients g = backward(s, r, loss);
   RasterFrame<double>& frame = r.frame;
   const auto evaluate = [&] {

@@ -150,11 +150,14 @@ KernelRender<T> kernel_render(const Scene<T>& s, const Camera& cam, const T back
   return r;
 }
 
-template <typename T>
-double max_abs_diff(const std::vector<T>& a, const std::vector<double>& b) {
+// Infinite for vectors of different sizes, so that a comparison against it fails.
+template <typename A, typename B>
+double max_abs_diff(const std::vector<A>& a, const std::vector<B>& b) {
+  if (a.size() != b.size()) return INFINITY;
   double worst = 0;
-  for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(double(a[i]) - b[i]));
-  return a.size() == b.size() ? worst : INFINITY;
+  for (size_t i = 0; i < a.size(); ++i)
+    worst = std::max(worst, std::abs(double(a[i]) - double(b[i])));
+  return worst;
 }
 
 }  // namespace iesrgs::raster::testkit

@@ -8,7 +8,7 @@
 namespace iesrgs::raster::testkit {
 namespace {
 
-const double kBackground[3] = {0.2, 0.5, 0.9};
+const double kRasterBackground[3] = {0.2, 0.5, 0.9};
 
 struct ReferenceCase {
   Camera camera;
@@ -19,14 +19,15 @@ struct ReferenceCase {
 void expect_matches_reference(const ReferenceCase& c, double tolerance_float,
                               double tolerance_double) {
   const Scene<double> scene = random_scene(c.camera, 60, c.degree, c.seed);
-  const ReferenceImage ref = reference_render(scene, c.camera, kBackground);
-  const float bg[3] = {float(kBackground[0]), float(kBackground[1]), float(kBackground[2])};
+  const ReferenceImage ref = reference_render(scene, c.camera, kRasterBackground);
+  const float bg[3] = {float(kRasterBackground[0]), float(kRasterBackground[1]),
+                       float(kRasterBackground[2])};
   const KernelRender<float> f = kernel_render(scene.cast<float>(), c.camera, bg);
   EXPECT_LT(max_abs_diff(f.image, ref.image), tolerance_float);
   EXPECT_LT(max_abs_diff(f.alpha, ref.alpha), tolerance_float);
   EXPECT_LT(max_abs_diff(f.depth, ref.depth), tolerance_float);
   // In double the kernels agree with the reference up to rounding: same cut-offs, same order.
-  const KernelRender<double> d = kernel_render(scene, c.camera, kBackground);
+  const KernelRender<double> d = kernel_render(scene, c.camera, kRasterBackground);
   EXPECT_LT(max_abs_diff(d.image, ref.image), tolerance_double);
   EXPECT_LT(max_abs_diff(d.alpha, ref.alpha), tolerance_double);
   EXPECT_LT(max_abs_diff(d.depth, ref.depth), tolerance_double);
@@ -49,7 +50,7 @@ TEST(RasterForward, EdgeCasesAreExercised) {
   // Guards the scene generator: the comparison above must actually meet every edge case.
   const Camera cam = test_camera(64, 48);
   const Scene<double> scene = random_scene(cam, 60, 3, 1);
-  const KernelRender<double> d = kernel_render(scene, cam, kBackground);
+  const KernelRender<double> d = kernel_render(scene, cam, kRasterBackground);
   const int first_edge = 60;
   EXPECT_EQ(d.radii[first_edge], 0);       // behind the camera
   EXPECT_EQ(d.radii[first_edge + 1], 0);   // in front of the near plane
@@ -75,7 +76,7 @@ TEST(RasterForward, SingleIsotropicGaussianHasClosedForm) {
   const double dc = (value - 0.5) / 0.28209479177387814;
   s.add({0, 0, z}, {std::log(scale), std::log(scale), std::log(scale)}, {1, 0, 0, 0},
         std::log(opacity / (1 - opacity)), {dc, dc, dc}, 0);
-  const KernelRender<double> r = kernel_render(s, cam, kBackground);
+  const KernelRender<double> r = kernel_render(s, cam, kRasterBackground);
   const double var = std::pow(k.fx * scale / z, 2);
   const double filtered_opacity = opacity * var / (var + 0.1);  // sqrt of the det ratio
   const size_t plane = size_t(k.width) * k.height;
@@ -89,7 +90,8 @@ TEST(RasterForward, SingleIsotropicGaussianHasClosedForm) {
       ASSERT_NEAR(r.alpha[i], alpha, 1e-12);
       ASSERT_NEAR(r.depth[i], alpha * z, 1e-12);
       for (int c = 0; c < 3; ++c)
-        ASSERT_NEAR(r.image[c * plane + i], alpha * value + (1 - alpha) * kBackground[c], 1e-12);
+        ASSERT_NEAR(r.image[c * plane + i], alpha * value + (1 - alpha) * kRasterBackground[c],
+                    1e-12);
     }
 }
 
@@ -120,9 +122,9 @@ TEST(RasterForward, SupersampledRenderMatchesAfterBoxFilter) {
     s.add(world_point(cam, 0.5 * u(rng), 0.4 * u(rng), 4 + u(rng)), {-1.5, -1.6, -1.4},
           random_quat(rng), -0.5 + 0.5 * u(rng), {u(rng), u(rng), u(rng)}, 0.01,
           std::vector<double>(9, 0.1));
-  const KernelRender<double> low = kernel_render(s, cam, kBackground);
+  const KernelRender<double> low = kernel_render(s, cam, kRasterBackground);
   const Camera high_cam = cam.scaled(4);
-  const KernelRender<double> high = kernel_render(s, high_cam, kBackground);
+  const KernelRender<double> high = kernel_render(s, high_cam, kRasterBackground);
   const auto down =
       box_downsample(high.image, high_cam.intrinsics.width, high_cam.intrinsics.height, 4);
   double worst = 0, mean = 0;

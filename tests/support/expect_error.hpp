@@ -1,6 +1,7 @@
 #pragma once
 // Runs `action` and returns the message of the iesrgs::Error it throws (a test failure when it
-// throws nothing), so bad-input tests can check that the message names the file and the problem.
+// throws nothing), so bad-input tests can check that the message names the file and the problem
+// (`contains`).
 #include <gtest/gtest.h>
 
 #include <string>
@@ -18,6 +19,10 @@ std::string error_message(Action&& action) {
   }
   ADD_FAILURE() << "expected an iesrgs::Error";
   return {};
+}
+
+inline bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
 }
 
 }  // namespace iesrgs::testing

@@ -10,13 +10,10 @@
 namespace iesrgs::priors::depth {
 namespace {
 
+using testing::contains;
 using testing::error_message;
 using testing::TempDir;
 using testing::write_text;
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 TEST(DepthFiles, FolderGivesOneJobPerImageByName) {
   TempDir dir;

@@ -7,14 +7,11 @@
 namespace iesrgs::priors::depth {
 namespace {
 
+using testing::contains;
 using testing::error_message;
 
 const std::filesystem::path kTiny =
     std::filesystem::path(IESRGS_TEST_DATA) / "priors" / "depth" / "tiny.pth";
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 TEST(MakeDepthNet, NoneTurnsTheDepthPriorOff) {
   EXPECT_EQ(make_depth_net("none", ""), nullptr);

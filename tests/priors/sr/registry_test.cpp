@@ -14,12 +14,9 @@
 namespace iesrgs::priors::sr {
 namespace {
 
+using iesrgs::testing::contains;
 using iesrgs::testing::error_message;
 using iesrgs::testing::TempDir;
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 // Sets (or with no value unsets) IESRGS_WEIGHTS_DIR for the scope and restores what was there.
 class WeightsDirOverride {
@@ -78,13 +75,13 @@ TEST(SrRegistry, MissingDefaultWeightsSayWhereTheyWereLookedFor) {
 }
 
 TEST(SrRegistry, CheckpointOfAnotherConfigurationNamesTheFile) {
-  const auto file = testing::kFixtures / "tiny_pan_x2.pth";
+  const auto file = sr_testing::kFixtures / "tiny_pan_x2.pth";
   const std::string message = error_message([&] { make_sr_net("pan", file, 4); });
   EXPECT_TRUE(contains(message, file.string())) << message;
 }
 
 TEST(SrRegistry, NetworksRejectInputsThatAreNotRgbBatches) {
-  const auto file = testing::kReleasedWeights / "PAN_x4.pth";
+  const auto file = sr_testing::kReleasedWeights / "PAN_x4.pth";
   if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found (shared data absent)";
   const auto net = make_sr_net("pan", file, 4);
   EXPECT_EQ(error_message([&] {
@@ -103,8 +100,8 @@ TEST(SrMeasurement, DISABLED_LegoTestViewPsnr) {
   for (const std::string model : {"bicubic", "safmn", "imdn", "pan"}) {
     const auto net = make_sr_net(model, {}, 4);
     for (const int index : views) {
-      const testing::ProtocolView view = testing::lego_test_view(index);
-      mean[model] += testing::psnr(net->upscale(view.low), view.high) / double(views.size());
+      const sr_testing::ProtocolView view = sr_testing::lego_test_view(index);
+      mean[model] += sr_testing::psnr(net->upscale(view.low), view.high) / double(views.size());
     }
     std::printf("%-8s %.2f dB mean over %zu lego test views\n", model.c_str(), mean[model],
                 views.size());
