@@ -23,20 +23,20 @@ namespace fs = std::filesystem;
 
 const fs::path kFixtures = fs::path(IESRGS_TEST_DATA) / "resize";
 
-struct Fixture {
+struct ResizeFixture {
   fs::path source, expected;
   int width = 0, height = 0;
 };
 
 // "<source stem>_to_<w>x<h>.png" is Pillow's resize of "<source stem>.png" to w x h.
-std::vector<Fixture> synthetic_fixtures() {
-  std::vector<Fixture> fixtures;
+std::vector<ResizeFixture> synthetic_fixtures() {
+  std::vector<ResizeFixture> fixtures;
   for (const auto& entry : fs::directory_iterator(kFixtures)) {
     const std::string file = entry.path().filename().string();
     const size_t to = file.find("_to_");
     if (to == std::string::npos) continue;  // a source image
     const std::string stem = file.substr(0, to);
-    Fixture f;
+    ResizeFixture f;
     if (stem == "lego_r_0" ||
         std::sscanf(file.c_str() + to, "_to_%dx%d.png", &f.width, &f.height) != 2)
       continue;
@@ -45,7 +45,7 @@ std::vector<Fixture> synthetic_fixtures() {
     fixtures.push_back(f);
   }
   std::sort(fixtures.begin(), fixtures.end(),
-            [](const Fixture& a, const Fixture& b) { return a.expected < b.expected; });
+            [](const ResizeFixture& a, const ResizeFixture& b) { return a.expected < b.expected; });
   return fixtures;
 }
 
@@ -66,10 +66,10 @@ int compare(const Image8& ours, const Image8& pillow) {
 }
 
 TEST(Resize, MatchesPillowOnEveryFixture) {
-  const std::vector<Fixture> fixtures = synthetic_fixtures();
+  const std::vector<ResizeFixture> fixtures = synthetic_fixtures();
   ASSERT_EQ(fixtures.size(), 56u) << "expected 4 modes x 14 resizes in " << kFixtures;
   std::map<int, int> worst_by_channels;
-  for (const Fixture& f : fixtures) {
+  for (const ResizeFixture& f : fixtures) {
     SCOPED_TRACE(f.expected.filename().string());
     const Image8 ours = resize_bicubic(read_image8(f.source), f.width, f.height);
     const int difference = compare(ours, read_image8(f.expected));

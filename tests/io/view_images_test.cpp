@@ -25,12 +25,12 @@ Camera camera_for(const std::filesystem::path& path, int w, int h) {
   return camera;
 }
 
-struct Fixture {
+struct SceneFixture {
   TempDir dir;
   Scene scene;
   ViewImageOptions options;
 
-  Fixture() { options.undistort_cache_dir = dir / "cache"; }
+  SceneFixture() { options.undistort_cache_dir = dir / "cache"; }
   const Camera& add(const std::string& name, const Image8& image) {
     write_png(dir / "images" / name, image);
     scene.cameras.push_back(camera_for(dir / "images" / name, image.width, image.height));
@@ -39,7 +39,7 @@ struct Fixture {
 };
 
 TEST(ViewImages, CompositesRgbaOverTheSceneBackground) {
-  Fixture f;
+  SceneFixture f;
   f.scene.background = {0, 0, 1};
   const Camera camera = f.add("a.png", solid(6, 4, {255, 0, 0, 0}));
   ViewImages images(f.scene, f.options);
@@ -51,7 +51,7 @@ TEST(ViewImages, CompositesRgbaOverTheSceneBackground) {
 }
 
 TEST(ViewImages, PrefersThePreDownscaledFolder) {
-  Fixture f;
+  SceneFixture f;
   Camera camera = f.add("a.png", solid(8, 8, {255, 0, 0}));
   write_png(f.dir / "images_2" / "a.png", solid(4, 4, {0, 255, 0}));
   f.scene.downscale = 2;
@@ -63,7 +63,7 @@ TEST(ViewImages, PrefersThePreDownscaledFolder) {
 }
 
 TEST(ViewImages, ResizesWhenNoDownscaledCopyExists) {
-  Fixture f;
+  SceneFixture f;
   Camera camera = f.add("a.png", solid(8, 6, {10, 200, 30}));
   f.scene.downscale = 2;
   camera.intrinsics = camera.stored.scaled(0.5);
@@ -75,7 +75,7 @@ TEST(ViewImages, ResizesWhenNoDownscaledCopyExists) {
 }
 
 TEST(ViewImages, WrongImageSizeNamesTheFile) {
-  Fixture f;
+  SceneFixture f;
   Camera camera = f.add("a.png", solid(8, 6, {1, 2, 3}));
   camera.stored.width = 9;
   ViewImages images(f.scene, f.options);
@@ -84,7 +84,7 @@ TEST(ViewImages, WrongImageSizeNamesTheFile) {
 }
 
 TEST(ViewImages, KeepsAtMostTheCacheBudget) {
-  Fixture f;
+  SceneFixture f;
   const Camera a = f.add("a.png", solid(4, 4, {1, 2, 3}));
   const Camera b = f.add("b.png", solid(4, 4, {4, 5, 6}));
   f.options.cache_bytes = 4 * 4 * 3 * sizeof(float);  // room for exactly one image
@@ -96,7 +96,7 @@ TEST(ViewImages, KeepsAtMostTheCacheBudget) {
 }
 
 TEST(ViewImages, UndistortsOnceIntoTheCache) {
-  Fixture f;
+  SceneFixture f;
   Camera camera = f.add("a.png", solid(16, 12, {9, 99, 199}));
   camera.distortion = {0.05, 0, 0, 0};
   ViewImages images(f.scene, f.options);

@@ -10,14 +10,14 @@ namespace nn = torch::nn;
 namespace {
 
 constexpr int kBlocks = 6;
-constexpr double kSlope = 0.05;  // of every LeakyReLU in IMDN
+constexpr double kImdnSlope = 0.05;  // of every LeakyReLU in IMDN
 
 nn::Conv2d conv(int64_t in, int64_t out, int64_t kernel) {
   return same_conv(in, out, kernel, true);
 }
 
-torch::Tensor leaky(const torch::Tensor& x) {
-  return torch::leaky_relu(x, kSlope);
+torch::Tensor imdn_leaky(const torch::Tensor& x) {
+  return torch::leaky_relu(x, kImdnSlope);
 }
 
 // Contrast-aware channel attention: the gate sees each channel's spatial standard deviation
@@ -62,7 +62,7 @@ class ImdModuleImpl : public nn::Module {
     torch::Tensor remaining = input;
     for (nn::Conv2d* stage : {&c1_, &c2_, &c3_}) {
       const std::vector<torch::Tensor> parts =
-          leaky((*stage)->forward(remaining)).split_with_sizes({distilled_, remaining_}, 1);
+          imdn_leaky((*stage)->forward(remaining)).split_with_sizes({distilled_, remaining_}, 1);
       distilled.push_back(parts[0]);
       remaining = parts[1];
     }
@@ -87,7 +87,7 @@ ImdnImpl::ImdnImpl(const ImdnOptions& options) {
     blocks_.emplace_back(register_module("IMDB" + std::to_string(i), ImdModule(nf)));
   c_ = register_module(
       "c", nn::Sequential(conv(nf * kBlocks, nf, 1),
-                          nn::LeakyReLU(nn::LeakyReLUOptions().negative_slope(kSlope))));
+                          nn::LeakyReLU(nn::LeakyReLUOptions().negative_slope(kImdnSlope))));
   lr_conv_ = register_module("LR_conv", conv(nf, nf, 3));
   upsampler_ = register_module(
       "upsampler", nn::Sequential(conv(nf, 3 * options.scale * options.scale, 3),

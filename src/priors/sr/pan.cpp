@@ -11,10 +11,10 @@ namespace nn = torch::nn;
 
 namespace {
 
-constexpr double kSlope = 0.2;  // of every LeakyReLU in PAN
+constexpr double kPanSlope = 0.2;  // of every LeakyReLU in PAN
 
-torch::Tensor leaky(const torch::Tensor& x) {
-  return torch::leaky_relu(x, kSlope);
+torch::Tensor pan_leaky(const torch::Tensor& x) {
+  return torch::leaky_relu(x, kPanSlope);
 }
 
 // Pixel-attention convolution: a 3x3 conv gated per pixel by a 1x1 conv, then another 3x3.
@@ -49,8 +49,8 @@ class ScpaImpl : public nn::Module {
   }
 
   torch::Tensor forward(const torch::Tensor& x) {
-    const torch::Tensor a = leaky(k1_->forward(leaky(conv1_a_->forward(x))));
-    const torch::Tensor b = leaky(pa_conv_->forward(leaky(conv1_b_->forward(x))));
+    const torch::Tensor a = pan_leaky(k1_->forward(pan_leaky(conv1_a_->forward(x))));
+    const torch::Tensor b = pan_leaky(pa_conv_->forward(pan_leaky(conv1_b_->forward(x))));
     return conv3_->forward(torch::cat({a, b}, 1)) + x;
   }
 
@@ -100,7 +100,7 @@ PanImpl::PanImpl(const PanOptions& options) : scale_(options.scale) {
 
 torch::Tensor PanImpl::upsample(UpStage& stage, const torch::Tensor& x) {
   const torch::Tensor up = stage.upconv->forward(upsample_nearest(x, stage.factor));
-  return leaky(stage.hr_conv->forward(leaky(stage.attention->forward(up))));
+  return pan_leaky(stage.hr_conv->forward(pan_leaky(stage.attention->forward(up))));
 }
 
 torch::Tensor PanImpl::forward(const torch::Tensor& rgb) {

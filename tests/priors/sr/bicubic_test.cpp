@@ -11,9 +11,11 @@ namespace {
 TEST(Bicubic, UpscalesLikePillow) {
   // Pillow's float ("F" mode) resize: the same filter as its 8-bit path, without the
   // quantization and clipping between passes.
-  const torch::Tensor pillow = testing::read_npy_tensor(testing::kFixtures / "bicubic_x4_lego.npy");
-  EXPECT_LT(testing::max_abs_difference(make_bicubic(4)->upscale(testing::lego_crop()), pillow),
-            1e-5);
+  const torch::Tensor pillow =
+      sr_testing::read_npy_tensor(sr_testing::kFixtures / "bicubic_x4_lego.npy");
+  EXPECT_LT(
+      sr_testing::max_abs_difference(make_bicubic(4)->upscale(sr_testing::lego_crop()), pillow),
+      1e-5);
 }
 
 TEST(Bicubic, KeepsFlatColours) {

@@ -8,10 +8,10 @@
 #include "eval/metrics.hpp"
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
+#include "io/image_tensor.hpp"
 #include "io/npy.hpp"
 #include "io/resize.hpp"
 #include "priors/keras_model.hpp"
-#include "io/image_tensor.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -20,11 +20,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-using testing::error_message;
-using testing::TempDir;
-using testing::write_text;
+using iesrgs::testing::error_message;
+using iesrgs::testing::TempDir;
+using iesrgs::testing::write_text;
 
-const fs::path kFixtures = fs::path(IESRGS_TEST_DATA) / "priors" / "esrgan";
+const fs::path kEsrganFixtures = fs::path(IESRGS_TEST_DATA) / "priors" / "esrgan";
 
 // An NHWC array written by make_fixtures.js, as an NCHW tensor.
 torch::Tensor read_nchw(const fs::path& file) {
@@ -39,16 +39,16 @@ double max_difference(const torch::Tensor& a, const torch::Tensor& b) {
 }
 
 TEST(KerasModel, MatchesTensorFlowJs) {
-  const auto model = keras::LayersModel::load(kFixtures / "tiny" / "model.json");
-  const torch::Tensor output = model.forward(read_nchw(kFixtures / "tiny_input.npy"));
-  EXPECT_LT(max_difference(output, read_nchw(kFixtures / "tiny_output.npy")), 1e-5);
+  const auto model = keras::LayersModel::load(kEsrganFixtures / "tiny" / "model.json");
+  const torch::Tensor output = model.forward(read_nchw(kEsrganFixtures / "tiny_input.npy"));
+  EXPECT_LT(max_difference(output, read_nchw(kEsrganFixtures / "tiny_output.npy")), 1e-5);
 }
 
 // A copy of the tiny model whose model.json `edit` changed, and the error loading it gives.
 template <typename Edit>
 std::string load_error(Edit edit) {
   TempDir dir;
-  for (const auto& entry : fs::directory_iterator(kFixtures / "tiny"))
+  for (const auto& entry : fs::directory_iterator(kEsrganFixtures / "tiny"))
     fs::copy_file(entry.path(), dir / entry.path().filename().string());
   json model = json::parse(read_file(dir / "model.json"));
   edit(model, dir);
@@ -96,7 +96,7 @@ TEST(KerasModel, NamesTheProblemWithABrokenModel) {
 
 TEST(KerasModel, NamesAMissingShardOrInvalidJson) {
   TempDir dir;
-  fs::copy_file(kFixtures / "tiny" / "model.json", dir / "model.json");
+  fs::copy_file(kEsrganFixtures / "tiny" / "model.json", dir / "model.json");
   EXPECT_EQ(error_message([&] {
               keras::LayersModel::load(dir / "model.json");
             }).find((dir / "group1-shard1of2.bin").string()),
@@ -118,8 +118,9 @@ TEST(Esrgan, SlimX4MatchesTensorFlowJs) {
   EXPECT_EQ(net->name(), "esrgan-slim");
   EXPECT_EQ(net->scale(), 4);
   // The fixture holds the model's own 0..255 values; upscale works in 0..1 and clips.
-  const torch::Tensor input = read_nchw(kFixtures / "slim_x4_input.npy") / 255;
-  const torch::Tensor expected = (read_nchw(kFixtures / "slim_x4_output.npy") / 255).clamp(0, 1);
+  const torch::Tensor input = read_nchw(kEsrganFixtures / "slim_x4_input.npy") / 255;
+  const torch::Tensor expected =
+      (read_nchw(kEsrganFixtures / "slim_x4_output.npy") / 255).clamp(0, 1);
   EXPECT_LT(max_difference(net->upscale(input), expected), 1e-4);
 }
 

@@ -8,7 +8,10 @@
 namespace iesrgs::priors::sr {
 namespace {
 
-using namespace testing;
+using sr_testing::kReleasedWeights;
+using sr_testing::parameter_count;
+using sr_testing::released_fixture_error;
+using sr_testing::tiny_fixture_error;
 
 TEST(Imdn, TinySeededConfigurationMatchesTheOfficialModule) {
   Imdn net(ImdnOptions{16, 2});

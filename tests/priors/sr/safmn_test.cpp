@@ -7,7 +7,11 @@
 namespace iesrgs::priors::sr {
 namespace {
 
-using namespace testing;
+using sr_testing::kReleasedWeights;
+using sr_testing::lego_crop;
+using sr_testing::parameter_count;
+using sr_testing::released_fixture_error;
+using sr_testing::tiny_fixture_error;
 
 TEST(Safmn, TinySeededConfigurationMatchesTheOfficialModule) {
   Safmn net(SafmnOptions{8, 2, 2.0, 2});

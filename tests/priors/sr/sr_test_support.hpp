@@ -10,13 +10,13 @@
 #include <vector>
 
 #include "io/image.hpp"
+#include "io/image_tensor.hpp"
 #include "io/npy.hpp"
 #include "io/resize.hpp"
-#include "io/image_tensor.hpp"
 #include "priors/sr/sr_net.hpp"
 #include "priors/state_dict.hpp"
 
-namespace iesrgs::priors::sr::testing {
+namespace iesrgs::priors::sr::sr_testing {
 
 inline const std::filesystem::path kFixtures =
     std::filesystem::path(IESRGS_TEST_DATA) / "priors" / "sr";
@@ -83,4 +83,4 @@ inline double psnr(const torch::Tensor& image, const torch::Tensor& reference) {
   return 10 * std::log10(1 / mse);
 }
 
-}  // namespace iesrgs::priors::sr::testing
+}  // namespace iesrgs::priors::sr::sr_testing

@@ -18,7 +18,7 @@
 namespace iesrgs::priors::sr {
 namespace {
 
-using testing::error_message;
+using iesrgs::testing::error_message;
 
 const std::filesystem::path kData = std::filesystem::path(IESRGS_TEST_DATA) / "priors/swinir";
 

@@ -13,7 +13,11 @@
 namespace iesrgs::priors::sr {
 namespace {
 
-using namespace testing;
+using sr_testing::kFixtures;
+using sr_testing::kReleasedWeights;
+using sr_testing::lego_test_view;
+using sr_testing::max_abs_difference;
+using sr_testing::psnr;
 
 // The tiny seeded PAN of the fixtures as an SrNet: a network whose receptive field is local
 // (about 8 input pixels), unlike SAFMN and IMDN, whose normalization and attention see the
