@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "eval/mask_agreement.hpp"
 #include "io/atomic_file.hpp"
 #include "io/image_tensor.hpp"
 #include "io/view_images.hpp"
@@ -86,6 +87,7 @@ class Pipeline {
   RowResult evaluate_row(const RowSpec& row, const gs::GaussianModel& model, const fs::path& dir);
   RowResult run_fusion_row(const RowSpec& row);
   void write_fusion_diagnostics(const gs::GaussianModel& model, const FusionSetup& setup) const;
+  void write_mask_agreement(const FusionSetup& setup) const;
 
   RunOptions o_;
   std::vector<std::string> rows_;
@@ -285,7 +287,10 @@ RowResult Pipeline::run_fusion_row(const RowSpec& row) {
       run_fusion_stage(std::move(setup), o_.fusion_config, row_params(row, weights), dir,
                        [this] { return initial_hr_model(); });
   stages_["fusion_seconds"][row.id] = stage.seconds;
-  if (!diagnostics_setup.cameras.empty()) write_fusion_diagnostics(stage.model, diagnostics_setup);
+  if (!diagnostics_setup.cameras.empty()) {
+    write_fusion_diagnostics(stage.model, diagnostics_setup);
+    write_mask_agreement(diagnostics_setup);
+  }
   RowResult result = evaluate_row(row, stage.model, dir);
   result.train_seconds = stage.seconds;
   return result;
@@ -314,6 +319,38 @@ void Pipeline::write_fusion_diagnostics(const gs::GaussianModel& model,
     views.push_back(std::move(view));
   }
   write_diagnostics(o_.output / "diagnostics", views, threshold_);
+}
+
+void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
+  if (!hr_scene_) return;
+  eval::MaskCounts counts;
+  const std::vector<const Camera*> truth_cameras = hr_scene_->split(Split::Train);
+  for (size_t i = 0; i < setup.cameras.size(); ++i) {
+    const loss::FusionTargets& targets = setup.targets[i];
+    const Camera& truth_camera = *truth_cameras[i];
+    if (!targets.internal_image.defined() ||
+        truth_camera.intrinsics.width != setup.cameras[i].intrinsics.width ||
+        truth_camera.intrinsics.height != setup.cameras[i].intrinsics.height)
+      return;
+    counts += eval::mask_counts(targets.internal_image, targets.external_image,
+                                to_tensor(*hr_images_->rgb(truth_camera))[0], threshold_);
+  }
+  const nlohmann::json json = {{"threshold", threshold_},
+                               {"views", setup.cameras.size()},
+                               {"mask_share", counts.mask_share()},
+                               {"truth_mask_share", counts.truth_mask_share()},
+                               {"precision", counts.precision()},
+                               {"recall", counts.recall()},
+                               {"iou", counts.iou()},
+                               {"internal_closer_share", counts.internal_closer_share()}};
+  const fs::path path = o_.output / "diagnostics" / "mask_agreement.json";
+  write_file_atomically(path, json.dump(2) + "\n");
+  fmt::print(
+      "mask M on {:.2f}% of the training pixels, the truth's mask G on {:.2f}%: IoU {:.3f}, "
+      "precision {:.3f}, recall {:.3f}; the internal image is the closer one at {:.1f}% of M "
+      "({})\n",
+      100 * counts.mask_share(), 100 * counts.truth_mask_share(), counts.iou(), counts.precision(),
+      counts.recall(), 100 * counts.internal_closer_share(), path.string());
 }
 
 RunResult Pipeline::run() {

@@ -49,6 +49,11 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
         "diagnostics/contact_sheet.png", "diagnostics/contact_sheet.html",
         "diagnostics/r_0/mask.png", "diagnostics/r_0/truth.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "run" / file)) << file;
+  const auto agreement =
+      nlohmann::json::parse(read_file(dir / "run" / "diagnostics/mask_agreement.json"));
+  EXPECT_EQ(agreement["views"], 6);
+  for (const char* key : {"mask_share", "truth_mask_share", "iou", "internal_closer_share"})
+    EXPECT_TRUE(agreement[key].get<double>() >= 0 && agreement[key].get<double>() <= 1) << key;
   const ImageHeader render = read_image_header(dir / "run" / "rows/ie-srgs/test/rgb/r_0.png");
   EXPECT_EQ(render.width, 48);
   EXPECT_EQ(read_image_header(dir / "run" / "internal/sr/rgb/r_0.png").width, 48);

@@ -1,0 +1,36 @@
+#pragma once
+// How well IE-SRGS's discrepancy mask finds the pixels where the external image is wrong, the
+// check of the paper's supplementary: the mask M = [D(I_image, E_image) >= T] against the mask
+// the HR ground truth gives, G = [D(truth, E_image) >= T], and whether the internal image is in
+// fact the closer reference where M picks it. Benchmarks only: it needs the HR training views.
+#include <torch/types.h>
+
+#include <cstdint>
+
+namespace iesrgs::eval {
+
+// Pixel counts, summed over views.
+struct MaskCounts {
+  int64_t pixels = 0;
+  int64_t mask = 0;             // |M|
+  int64_t truth_mask = 0;       // |G|
+  int64_t both = 0;             // |M and G|
+  int64_t internal_closer = 0;  // pixels of M where |I - truth| < |E - truth| (channel means)
+
+  MaskCounts& operator+=(const MaskCounts& other);
+  double mask_share() const { return share(mask, pixels); }
+  double truth_mask_share() const { return share(truth_mask, pixels); }
+  double precision() const { return share(both, mask); }  // of M, the share inside G
+  double recall() const { return share(both, truth_mask); }
+  double iou() const { return share(both, mask + truth_mask - both); }
+  double internal_closer_share() const { return share(internal_closer, mask); }
+
+ private:
+  static double share(int64_t part, int64_t whole) { return whole ? double(part) / whole : 0; }
+};
+
+// Counts of one view; all three images (3, H, W) float in [0, 1].
+MaskCounts mask_counts(const torch::Tensor& internal_image, const torch::Tensor& external_image,
+                       const torch::Tensor& truth, double threshold);
+
+}  // namespace iesrgs::eval
