@@ -160,7 +160,6 @@ double Trainer::step(int64_t iteration) {
   optimizer_->step(model_);
   for (int p = 0; p < gs::kParamCount; ++p)
     model_.param(gs::Param(p)).mutable_grad() = torch::Tensor();
-  densify(iteration);
   return total;
 }
 
@@ -238,6 +237,8 @@ TrainSummary Trainer::run() {
       test_psnr = report_test_psnr();
       summary.test_psnr = *test_psnr;
     }
+    // After the report: an opacity reset on the same iteration would make it read ~12 dB.
+    densify(iteration_);
     log.record(iteration_, loss, model_.size(), test_psnr, last);
     const bool interrupted = interrupt_requested.load();
     if (last || interrupted ||

@@ -66,7 +66,7 @@ class Trainer {
   double evaluate_psnr(const std::vector<TrainView>& views) const;
 
  private:
-  double step(int64_t iteration);  // returns the loss
+  double step(int64_t iteration);  // one optimizer step; returns the loss
   std::vector<int> pick_views();
   void densify(int64_t iteration);
   void save_checkpoint();
