@@ -47,8 +47,11 @@ Scene read_any_format(const fs::path& root, const SceneOptions& options) {
 
 }  // namespace
 
-Scene load_scene(const fs::path& root, const SceneOptions& options) {
+Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   if (options.downscale < 1) fail("--downscale must be at least 1, got {}", options.downscale);
+  // Absolute, so that the cached stages keyed by the scene's paths are found again from any
+  // working directory.
+  const fs::path root = fs::absolute(given_root).lexically_normal();
   Scene scene = read_any_format(root, options);
   if (scene.cameras.empty()) fail_file(root, "scene has no cameras");
   scene.root = root;

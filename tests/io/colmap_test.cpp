@@ -354,6 +354,17 @@ TEST(Colmap, LoadSceneDispatchesToColmap) {
   EXPECT_DOUBLE_EQ(a.intrinsics.fx, 700.25 / 2);
 }
 
+TEST(Colmap, RelativeScenePathsBecomeAbsolute) {
+  TempDir root;
+  write_sample_scene(root.path());
+  const std::filesystem::path relative =
+      std::filesystem::relative(root.path(), std::filesystem::current_path());
+  ASSERT_TRUE(relative.is_relative());
+  const Scene scene = load_scene(relative);
+  EXPECT_EQ(scene.root, std::filesystem::absolute(root.path()).lexically_normal());
+  EXPECT_TRUE(scene.cameras.front().image_path.is_absolute());
+}
+
 TEST(Colmap, ModelDirectlyInSparseIsFound) {
   TempDir root;
   write_sample_scene(root.path(), "sparse");
