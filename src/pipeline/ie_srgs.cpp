@@ -88,6 +88,9 @@ class Pipeline {
   RowResult run_fusion_row(const RowSpec& row);
   void write_fusion_diagnostics(const gs::GaussianModel& model, const FusionSetup& setup) const;
   void write_mask_agreement(const FusionSetup& setup) const;
+  // The HR ground truth of training view i, (3, H, W); undefined when the run has none at
+  // `camera`'s size.
+  torch::Tensor train_truth(size_t i, const Camera& camera) const;
 
   RunOptions o_;
   std::vector<std::string> rows_;
@@ -304,36 +307,29 @@ void Pipeline::write_fusion_diagnostics(const gs::GaussianModel& model,
     const size_t i = k * setup.cameras.size() / count;
     const Camera& camera = setup.cameras[i];
     const RenderedView render = render_view(model, camera, setup.background);
-    DiagnosticView view{camera.name,
-                        setup.targets[i].external_image,
-                        setup.targets[i].internal_image,
-                        render.image,
-                        render.depth,
-                        {}};
-    if (hr_scene_) {
-      const Camera& truth_camera = *hr_scene_->split(Split::Train)[i];
-      if (truth_camera.intrinsics.width == camera.intrinsics.width &&
-          truth_camera.intrinsics.height == camera.intrinsics.height)
-        view.truth = to_tensor(*hr_images_->rgb(truth_camera))[0];
-    }
-    views.push_back(std::move(view));
+    views.push_back({camera.name, setup.targets[i].external_image, setup.targets[i].internal_image,
+                     render.image, render.depth, train_truth(i, camera)});
   }
   write_diagnostics(o_.output / "diagnostics", views, threshold_);
 }
 
+torch::Tensor Pipeline::train_truth(size_t i, const Camera& camera) const {
+  if (!hr_scene_) return {};
+  const Camera& truth_camera = *hr_scene_->split(Split::Train)[i];
+  if (truth_camera.intrinsics.width != camera.intrinsics.width ||
+      truth_camera.intrinsics.height != camera.intrinsics.height)
+    return {};
+  return to_tensor(*hr_images_->rgb(truth_camera))[0];
+}
+
 void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
-  if (!hr_scene_) return;
   eval::MaskCounts counts;
-  const std::vector<const Camera*> truth_cameras = hr_scene_->split(Split::Train);
   for (size_t i = 0; i < setup.cameras.size(); ++i) {
     const loss::FusionTargets& targets = setup.targets[i];
-    const Camera& truth_camera = *truth_cameras[i];
-    if (!targets.internal_image.defined() ||
-        truth_camera.intrinsics.width != setup.cameras[i].intrinsics.width ||
-        truth_camera.intrinsics.height != setup.cameras[i].intrinsics.height)
-      return;
-    counts += eval::mask_counts(targets.internal_image, targets.external_image,
-                                to_tensor(*hr_images_->rgb(truth_camera))[0], threshold_);
+    if (!targets.internal_image.defined()) return;
+    const torch::Tensor truth = train_truth(i, setup.cameras[i]);
+    if (!truth.defined()) return;
+    counts += eval::mask_counts(targets.internal_image, targets.external_image, truth, threshold_);
   }
   const nlohmann::json json = {{"threshold", threshold_},
                                {"views", setup.cameras.size()},
