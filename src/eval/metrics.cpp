@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/image_tensor.hpp"
 #include "loss/ssim.hpp"
 
 namespace iesrgs::eval {
@@ -19,14 +20,6 @@ void check_pair(const Image& image, const Image& reference) {
   if (image.width != reference.width || image.height != reference.height)
     fail("image is {}x{} but its reference is {}x{}", image.width, image.height, reference.width,
          reference.height);
-}
-
-std::vector<float> to_planar(const Image& image) {
-  const size_t pixels = size_t(image.width) * size_t(image.height);
-  std::vector<float> planar(pixels * 3);
-  for (size_t p = 0; p < pixels; ++p)
-    for (int c = 0; c < 3; ++c) planar[size_t(c) * pixels + p] = image.data[p * 3 + size_t(c)];
-  return planar;
 }
 
 nlohmann::json to_json(const ViewMetrics& m) {
@@ -55,8 +48,9 @@ double psnr(const Image& image, const Image& reference) {
 
 double ssim(const Image& image, const Image& reference) {
   check_pair(image, reference);
-  const std::vector<float> x = to_planar(image), y = to_planar(reference);
-  return loss::ssim<float>(x.data(), y.data(), {image.width, image.height, 3}, nullptr, nullptr);
+  const torch::Tensor x = to_tensor(image), y = to_tensor(reference);  // planar copies
+  return loss::ssim<float>(x.data_ptr<float>(), y.data_ptr<float>(), {image.width, image.height, 3},
+                           nullptr, nullptr);
 }
 
 ViewMetrics MetricsReport::mean() const {

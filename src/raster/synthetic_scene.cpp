@@ -7,19 +7,6 @@
 
 namespace iesrgs::raster {
 
-GaussianParams<float> GaussianCloud::params() const {
-  GaussianParams<float> g;
-  g.count = count();
-  g.sh_degree = sh_degree;
-  g.means = means.data();
-  g.log_scales = log_scales.data();
-  g.quats = quats.data();
-  g.opacity_logits = opacity_logits.data();
-  g.sh = sh.data();
-  g.filter_std = filter_std.data();
-  return g;
-}
-
 RasterCamera<float> benchmark_camera(int width, int height) {
   RasterCamera<float> cam;
   cam.width = width;

@@ -4,19 +4,12 @@
 // log-normal sizes (median about 1.2 px standard deviation on screen, a long tail of large ones),
 // spread-out opacities, degree-3 SH, and Mip-Splatting 3D filters for this camera.
 #include <cstdint>
-#include <vector>
 
 #include "raster/types.hpp"
 
 namespace iesrgs::raster {
 
-struct GaussianCloud {
-  int sh_degree = 3;
-  std::vector<float> means, log_scales, quats, opacity_logits, sh, filter_std;
-
-  int count() const { return int(opacity_logits.size()); }
-  GaussianParams<float> params() const;
-};
+using GaussianCloud = GaussianBuffers<float>;
 
 // Camera at the origin looking down +z with NeRF Synthetic's field of view (about 40 degrees).
 RasterCamera<float> benchmark_camera(int width, int height);

@@ -1,6 +1,7 @@
 #pragma once
 // Plain data shared by the raster kernels: camera, Gaussian parameters, per-Gaussian splats.
 #include <cstdint>
+#include <vector>
 
 #include "raster/hd.hpp"
 
@@ -29,6 +30,20 @@ struct GaussianParams {
   const T* opacity_logits = nullptr;  // (N)
   const T* sh = nullptr;              // (N, 16, 3)
   const T* filter_std = nullptr;      // (N) Mip-Splatting 3D filter; nullptr means none
+};
+
+// Owning storage behind GaussianParams: the benchmarks' scenes and the kernel tests' scenes.
+template <typename T>
+struct GaussianBuffers {
+  int sh_degree = 3;
+  std::vector<T> means, log_scales, quats, opacity_logits, sh, filter_std;
+
+  int count() const { return int(opacity_logits.size()); }
+  GaussianParams<T> params() const {
+    return {count(),           sh_degree,        means.data(),
+            log_scales.data(), quats.data(),     opacity_logits.data(),
+            sh.data(),         filter_std.data()};
+  }
 };
 
 // Gradients with respect to GaussianParams, same shapes, plus the screen-space gradients that

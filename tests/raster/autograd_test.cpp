@@ -26,10 +26,10 @@ TEST(RasterAutograd, GradientsMatchTheRawBackward) {
   GaussianTensors g{tensor_of(s.means, {n, 3}),
                     tensor_of(s.log_scales, {n, 3}),
                     tensor_of(s.quats, {n, 4}),
-                    tensor_of(s.logits, {n}),
+                    tensor_of(s.opacity_logits, {n}),
                     tensor_of(s.sh, {n, 16, 3}),
-                    torch::tensor(s.filter),
-                    s.degree};
+                    torch::tensor(s.filter_std),
+                    s.sh_degree};
   ViewspaceProbes probes{torch::zeros({n, 2}).set_requires_grad(true),
                          torch::zeros({n, 2}).set_requires_grad(true)};
   const RenderOutput out = render(g, raster_camera<float>(cam), {bg[0], bg[1], bg[2]}, probes);
@@ -67,10 +67,10 @@ TEST(RasterAutograd, FilterAndProbesAreOptional) {
   GaussianTensors g{tensor_of(s.means, {n, 3}),
                     tensor_of(s.log_scales, {n, 3}),
                     tensor_of(s.quats, {n, 4}),
-                    tensor_of(s.logits, {n}),
+                    tensor_of(s.opacity_logits, {n}),
                     tensor_of(s.sh, {n, 16, 3}),
                     torch::Tensor(),
-                    s.degree};
+                    s.sh_degree};
   const RenderOutput plain = render(g, raster_camera<float>(cam), {1, 1, 1});
   plain.image.sum().backward();
   const torch::Tensor grad_without_filter = g.means.grad().clone();

@@ -88,7 +88,7 @@ void check_every_group(const Camera& cam, Scene<double> s, unsigned seed) {
   EXPECT_LT(group_error(s.means, g.means, evaluate), 1e-2) << "means";
   EXPECT_LT(group_error(s.log_scales, g.log_scales, evaluate), 1e-2) << "log-scales";
   EXPECT_LT(group_error(s.quats, g.quats, evaluate), 1e-2) << "quaternions";
-  EXPECT_LT(group_error(s.logits, g.logits, evaluate), 1e-2) << "opacity logits";
+  EXPECT_LT(group_error(s.opacity_logits, g.logits, evaluate), 1e-2) << "opacity logits";
   EXPECT_LT(group_error(s.sh, g.sh, evaluate), 1e-2) << "SH";
 }
 
@@ -97,7 +97,7 @@ TEST(RasterBackward, MatchesFiniteDifferencesOnRandomScene) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1, 1), unit(0, 1);
   Scene<double> s;
-  s.degree = 3;
+  s.sh_degree = 3;
   for (int i = 0; i < 14; ++i) {
     std::vector<double> rest(45);
     for (double& x : rest) x = 0.2 * u(rng);

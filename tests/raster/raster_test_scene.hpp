@@ -10,47 +10,39 @@
 
 namespace iesrgs::raster::testkit {
 
-// Owning storage behind GaussianParams, in any scalar type.
+// GaussianBuffers in any scalar type, built one Gaussian at a time.
 template <typename T>
-struct Scene {
-  int degree = 0;
-  std::vector<T> means, log_scales, quats, logits, sh, filter;
+struct Scene : GaussianBuffers<T> {
+  Scene() { this->sh_degree = 0; }
 
-  int count() const { return int(logits.size()); }
-  GaussianParams<T> params() const {
-    GaussianParams<T> g;
-    g.count = count();
-    g.sh_degree = degree;
-    g.means = means.data();
-    g.log_scales = log_scales.data();
-    g.quats = quats.data();
-    g.opacity_logits = logits.data();
-    g.sh = sh.data();
-    g.filter_std = filter.data();
-    return g;
-  }
   template <typename U>
   Scene<U> cast() const {
     const auto conv = [](const std::vector<T>& v) { return std::vector<U>(v.begin(), v.end()); };
-    return {degree,       conv(means), conv(log_scales), conv(quats),
-            conv(logits), conv(sh),    conv(filter)};
+    Scene<U> s;
+    s.sh_degree = this->sh_degree;
+    s.means = conv(this->means);
+    s.log_scales = conv(this->log_scales);
+    s.quats = conv(this->quats);
+    s.opacity_logits = conv(this->opacity_logits);
+    s.sh = conv(this->sh);
+    s.filter_std = conv(this->filter_std);
+    return s;
   }
   // Appends one Gaussian; sh_dc sets the DC color term, higher bands from `rest`.
   void add(const Vec3& mean, const Vec3& log_scale, const std::array<double, 4>& quat, double logit,
-           const std::array<double, 3>& dc, double filter_std,
-           const std::vector<double>& rest = {}) {
+           const std::array<double, 3>& dc, double filter, const std::vector<double>& rest = {}) {
     for (int k = 0; k < 3; ++k) {
-      means.push_back(T(mean[k]));
-      log_scales.push_back(T(log_scale[k]));
+      this->means.push_back(T(mean[k]));
+      this->log_scales.push_back(T(log_scale[k]));
     }
-    for (double q : quat) quats.push_back(T(q));
-    logits.push_back(T(logit));
+    for (double q : quat) this->quats.push_back(T(q));
+    this->opacity_logits.push_back(T(logit));
     for (int k = 0; k < gs::kShCoefficients; ++k)
       for (int c = 0; c < 3; ++c) {
         const size_t r = size_t(3 * (k - 1) + c);
-        sh.push_back(T(k == 0 ? dc[c] : (r < rest.size() ? rest[r] : 0.0)));
+        this->sh.push_back(T(k == 0 ? dc[c] : (r < rest.size() ? rest[r] : 0.0)));
       }
-    filter.push_back(T(filter_std));
+    this->filter_std.push_back(T(filter));
   }
 };
 
@@ -95,7 +87,7 @@ inline Scene<double> random_scene(const Camera& cam, int count, int degree, unsi
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1), unit(0, 1);
   Scene<double> s;
-  s.degree = degree;
+  s.sh_degree = degree;
   const auto rest = [&] {
     std::vector<double> r(3 * (gs::kShCoefficients - 1));
     for (double& x : r) x = 0.15 * u(rng);

@@ -117,7 +117,7 @@ TEST(RasterForward, SupersampledRenderMatchesAfterBoxFilter) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
   Scene<double> s;
-  s.degree = 1;
+  s.sh_degree = 1;
   for (int i = 0; i < 25; ++i)
     s.add(world_point(cam, 0.5 * u(rng), 0.4 * u(rng), 4 + u(rng)), {-1.5, -1.6, -1.4},
           random_quat(rng), -0.5 + 0.5 * u(rng), {u(rng), u(rng), u(rng)}, 0.01,
@@ -175,9 +175,9 @@ TEST(RasterForward, RejectsInvalidInput) {
   Camera cam = test_camera(16, 16);
   Scene<float> s = random_scene(cam, 3, 3, 1).cast<float>();
   const float bg[3] = {0, 0, 0};
-  s.degree = 4;
+  s.sh_degree = 4;
   EXPECT_THROW(kernel_render(s, cam, bg), Error);
-  s.degree = 3;
+  s.sh_degree = 3;
   cam.intrinsics.width = 0;
   EXPECT_THROW(kernel_render(s, cam, bg), Error);
 }

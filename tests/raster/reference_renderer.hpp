@@ -60,7 +60,7 @@ inline bool reference_project(const Scene<double>& s, int i, const Camera& cam,
   double ratio3d = 1;
   for (int a = 0; a < 3; ++a) {
     const double s2 = std::exp(2 * s.log_scales[3 * i + a]);
-    var(a, a) = s2 + s.filter[i] * s.filter[i];
+    var(a, a) = s2 + s.filter_std[i] * s.filter_std[i];
     ratio3d *= s2 / var(a, a);
   }
   const Mat3 sigma = rot * var * rot.transposed();
@@ -78,14 +78,14 @@ inline bool reference_project(const Scene<double>& s, int i, const Camera& cam,
   out.x = k.fx * v.x / v.z + k.cx;
   out.y = k.fy * v.y / v.z + k.cy;
   out.depth = v.z;
-  out.opacity = 1 / (1 + std::exp(-s.logits[i])) * std::sqrt(ratio3d) *
+  out.opacity = 1 / (1 + std::exp(-s.opacity_logits[i])) * std::sqrt(ratio3d) *
                 std::sqrt(std::max(0.000025, det0 / det1));
   out.conic[0] = c / det1;
   out.conic[1] = -b / det1;
   out.conic[2] = a / det1;
   Vec3 dir = mean - cam.center();
   dir = dir * (1 / dir.norm());
-  for (int ch = 0; ch < 3; ++ch) out.color[ch] = sh_channel(s.degree, &s.sh[48 * i], ch, dir);
+  for (int ch = 0; ch < 3; ++ch) out.color[ch] = sh_channel(s.sh_degree, &s.sh[48 * i], ch, dir);
   return true;
 }
 
