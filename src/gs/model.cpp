@@ -88,6 +88,13 @@ raster::GaussianTensors GaussianModel::render_tensors() const {
           filter_3d, active_sh_degree};
 }
 
+GaussianModel GaussianModel::clone() const {
+  GaussianModel copy = *this;
+  for (int p = 0; p < kParamCount; ++p) copy.set_param(Param(p), param(Param(p)));
+  if (filter_3d.defined()) copy.filter_3d = filter_3d.clone();
+  return copy;
+}
+
 void GaussianModel::set_param(Param p, const torch::Tensor& value) {
   param(p) = value.detach().clone().contiguous().requires_grad_(true);
 }

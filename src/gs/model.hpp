@@ -35,6 +35,10 @@ struct GaussianModel {
   // The tensors the rasterizer takes; the SH cat keeps the autograd path to both SH leaves.
   raster::GaussianTensors render_tensors() const;
 
+  // A copy that shares no storage with this model. Copying the struct shares the tensors, and
+  // the optimizer updates them in place, so training such a copy would change this model too.
+  GaussianModel clone() const;
+
   // The optimized tensor becomes a contiguous copy of `value`, a fresh leaf that requires grad.
   void set_param(Param p, const torch::Tensor& value);
   void set_params(const std::array<torch::Tensor, kParamCount>& values);

@@ -258,7 +258,7 @@ nlohmann::json Pipeline::row_params(const RowSpec& row, const loss::FusionWeight
 
 gs::GaussianModel Pipeline::initial_hr_model() const {
   if (o_.init == "internal") {
-    gs::GaussianModel model = internal_->training.model;
+    gs::GaussianModel model = internal_->training.model.clone();  // rows later still need it
     model.active_sh_degree = 0;  // the HR schedule raises the SH degree again
     return model;
   }

@@ -99,5 +99,26 @@ TEST(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
   EXPECT_TRUE(contains(last_line(hr.output), "needs HR images")) << hr.output;
 }
 
+// Rows that start from the internal model train a copy: the internal-only row, evaluated after
+// the bicubic row trained from it, still renders the model as the internal stage left it.
+TEST(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 2 --seed 3").status, 0);
+  const auto internal_psnr = [&] {
+    const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+    for (const auto& row : results["rows"])
+      if (row["row"] == "internal") return row["psnr"].get<double>();
+    ADD_FAILURE() << "no internal row in " << results.dump();
+    return 0.0;
+  };
+  ASSERT_EQ(iesrgs("run " + scene + " -o " + out + " --rows internal" + kTinySchedule).status, 0);
+  const double alone = internal_psnr();
+  const CliRun after_bicubic = iesrgs("run " + scene + " -o " + out +
+                                      " --init internal --rows bicubic,internal" + kTinySchedule);
+  ASSERT_EQ(after_bicubic.status, 0) << after_bicubic.output;
+  EXPECT_EQ(internal_psnr(), alone);
+}
+
 }  // namespace
 }  // namespace iesrgs

@@ -147,5 +147,22 @@ TEST(GaussianModel, RenderTensorsJoinTheShBands) {
   EXPECT_TRUE(m.sh_rest.grad().defined());
 }
 
+TEST(GaussianModel, CloneSharesNoStorage) {
+  const GaussianModel original = filtered_model(4);
+  const GaussianModel before = original.clone();
+  GaussianModel copy = original.clone();
+  {
+    torch::NoGradGuard no_grad;  // in place, as the optimizer steps
+    for (int p = 0; p < kParamCount; ++p) copy.param(Param(p)).add_(1);
+    copy.filter_3d.add_(1);
+  }
+  for (int p = 0; p < kParamCount; ++p) {
+    EXPECT_TRUE(torch::equal(original.param(Param(p)), before.param(Param(p)))) << p;
+    EXPECT_TRUE(copy.param(Param(p)).requires_grad()) << p;
+  }
+  EXPECT_TRUE(torch::equal(original.filter_3d, before.filter_3d));
+  EXPECT_EQ(copy.active_sh_degree, original.active_sh_degree);
+}
+
 }  // namespace
 }  // namespace iesrgs::gs
