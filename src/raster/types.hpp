@@ -40,9 +40,16 @@ struct GaussianBuffers {
 
   int count() const { return int(opacity_logits.size()); }
   GaussianParams<T> params() const {
-    return {count(),           sh_degree,        means.data(),
-            log_scales.data(), quats.data(),     opacity_logits.data(),
-            sh.data(),         filter_std.data()};
+    GaussianParams<T> g;
+    g.count = count();
+    g.sh_degree = sh_degree;
+    g.means = means.data();
+    g.log_scales = log_scales.data();
+    g.quats = quats.data();
+    g.opacity_logits = opacity_logits.data();
+    g.sh = sh.data();
+    g.filter_std = filter_std.data();
+    return g;
   }
 };
 
