@@ -2,6 +2,8 @@
 
 #include <torch/torch.h>
 
+#include <cmath>
+
 #include "loss/fusion.hpp"
 
 namespace iesrgs::eval {
@@ -12,7 +14,15 @@ MaskCounts& MaskCounts::operator+=(const MaskCounts& other) {
   truth_mask += other.truth_mask;
   both += other.both;
   internal_closer += other.internal_closer;
+  external_error += other.external_error;
+  internal_error += other.internal_error;
+  fused_error += other.fused_error;
   return *this;
+}
+
+double MaskCounts::psnr(double squared_error) const {
+  constexpr int kChannels = 3;
+  return -10.0 * std::log10(squared_error / double(kChannels * pixels));
 }
 
 MaskCounts mask_counts(const torch::Tensor& internal_image, const torch::Tensor& external_image,
@@ -21,13 +31,20 @@ MaskCounts mask_counts(const torch::Tensor& internal_image, const torch::Tensor&
   const torch::Tensor truth_mask = loss::discrepancy(truth, external_image) >= threshold;
   const torch::Tensor closer =
       (internal_image - truth).abs().mean(0) < (external_image - truth).abs().mean(0);
+  const torch::Tensor fused = torch::where(mask, internal_image, external_image);
   const auto count = [](const torch::Tensor& t) { return t.sum().item<int64_t>(); };
+  const auto squared_error = [&](const torch::Tensor& t) {
+    return (t - truth).square().sum().item<double>();
+  };
   MaskCounts counts;
   counts.pixels = mask.numel();
   counts.mask = count(mask);
   counts.truth_mask = count(truth_mask);
   counts.both = count(mask & truth_mask);
   counts.internal_closer = count(mask & closer);
+  counts.external_error = squared_error(external_image);
+  counts.internal_error = squared_error(internal_image);
+  counts.fused_error = squared_error(fused);
   return counts;
 }
 

@@ -2,7 +2,9 @@
 // How well IE-SRGS's discrepancy mask finds the pixels where the external image is wrong, the
 // check of the paper's supplementary: the mask M = [D(I_image, E_image) >= T] against the mask
 // the HR ground truth gives, G = [D(truth, E_image) >= T], and whether the internal image is in
-// fact the closer reference where M picks it. Benchmarks only: it needs the HR training views.
+// fact the closer reference where M picks it; and how close each reference is to the truth:
+// E_image, I_image and the fused reference the mask-guided loss pulls towards (I_image on M,
+// E_image elsewhere). Benchmarks only: it needs the HR training views.
 #include <torch/types.h>
 
 #include <cstdint>
@@ -16,6 +18,8 @@ struct MaskCounts {
   int64_t truth_mask = 0;       // |G|
   int64_t both = 0;             // |M and G|
   int64_t internal_closer = 0;  // pixels of M where |I - truth| < |E - truth| (channel means)
+  // Squared errors against the truth, summed over every channel value.
+  double external_error = 0, internal_error = 0, fused_error = 0;
 
   MaskCounts& operator+=(const MaskCounts& other);
   double mask_share() const { return share(mask, pixels); }
@@ -24,6 +28,8 @@ struct MaskCounts {
   double recall() const { return share(both, truth_mask); }
   double iou() const { return share(both, mask + truth_mask - both); }
   double internal_closer_share() const { return share(internal_closer, mask); }
+  // PSNR of a reference over all pixels and channels, from one of the squared-error sums.
+  double psnr(double squared_error) const;
 
  private:
   static double share(int64_t part, int64_t whole) { return whole ? double(part) / whole : 0; }

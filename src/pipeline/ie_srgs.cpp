@@ -338,15 +338,22 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
                                {"precision", counts.precision()},
                                {"recall", counts.recall()},
                                {"iou", counts.iou()},
-                               {"internal_closer_share", counts.internal_closer_share()}};
+                               {"internal_closer_share", counts.internal_closer_share()},
+                               {"psnr_external", counts.psnr(counts.external_error)},
+                               {"psnr_internal", counts.psnr(counts.internal_error)},
+                               {"psnr_fused", counts.psnr(counts.fused_error)}};
   const fs::path path = o_.output / "diagnostics" / "mask_agreement.json";
   write_file_atomically(path, json.dump(2) + "\n");
   fmt::print(
       "mask M on {:.2f}% of the training pixels, the truth's mask G on {:.2f}%: IoU {:.3f}, "
       "precision {:.3f}, recall {:.3f}; the internal image is the closer one at {:.1f}% of M "
-      "({})\n",
+      "({})\n"
+      "references against the HR truth: E_image {:.2f} dB, I_image {:.2f} dB, fused by M {:.2f} "
+      "dB\n",
       100 * counts.mask_share(), 100 * counts.truth_mask_share(), counts.iou(), counts.precision(),
-      counts.recall(), 100 * counts.internal_closer_share(), path.string());
+      counts.recall(), 100 * counts.internal_closer_share(), path.string(),
+      counts.psnr(counts.external_error), counts.psnr(counts.internal_error),
+      counts.psnr(counts.fused_error));
 }
 
 RunResult Pipeline::run() {

@@ -54,6 +54,8 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
   EXPECT_EQ(agreement["views"], 6);
   for (const char* key : {"mask_share", "truth_mask_share", "iou", "internal_closer_share"})
     EXPECT_TRUE(agreement[key].get<double>() >= 0 && agreement[key].get<double>() <= 1) << key;
+  for (const char* key : {"psnr_external", "psnr_internal", "psnr_fused"})
+    EXPECT_GT(agreement[key].get<double>(), 8.0) << key;
   const ImageHeader render = read_image_header(dir / "run" / "rows/ie-srgs/test/rgb/r_0.png");
   EXPECT_EQ(render.width, 48);
   EXPECT_EQ(read_image_header(dir / "run" / "internal/sr/rgb/r_0.png").width, 48);

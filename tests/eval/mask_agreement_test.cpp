@@ -24,6 +24,8 @@ TEST(MaskAgreement, MaskFindsTheWrongExternalPixelsWhenTheInternalImageIsRight) 
   EXPECT_DOUBLE_EQ(counts.precision(), 1);
   EXPECT_DOUBLE_EQ(counts.internal_closer_share(), 1);
   EXPECT_DOUBLE_EQ(counts.mask_share(), 2.0 / 16);
+  EXPECT_EQ(counts.fused_error, 0);  // the mask swaps exactly the wrong pixels for right ones
+  EXPECT_NEAR(counts.external_error, 2 * 3 * 0.45 * 0.45, 1e-5);
 }
 
 TEST(MaskAgreement, MaskPicksTheWrongInternalPixels) {
@@ -35,6 +37,9 @@ TEST(MaskAgreement, MaskPicksTheWrongInternalPixels) {
   EXPECT_DOUBLE_EQ(counts.precision(), 0);
   EXPECT_DOUBLE_EQ(counts.recall(), 0);  // an empty G: no pixel to find
   EXPECT_DOUBLE_EQ(counts.internal_closer_share(), 0);
+  // The fused reference takes the one wrong pixel: 3 of 48 values off by 0.4, MSE 0.01.
+  EXPECT_NEAR(counts.psnr(counts.fused_error), 20, 1e-4);
+  EXPECT_EQ(counts.external_error, 0);
 }
 
 TEST(MaskAgreement, CountsAddUp) {
@@ -46,6 +51,7 @@ TEST(MaskAgreement, CountsAddUp) {
   EXPECT_EQ(sum.both, 2);
   EXPECT_DOUBLE_EQ(sum.precision(), 2.0 / 3);
   EXPECT_DOUBLE_EQ(sum.iou(), 2.0 / 3);
+  EXPECT_NEAR(sum.fused_error, 3 * 0.4 * 0.4, 1e-5);
 }
 
 }  // namespace
