@@ -2,8 +2,7 @@
 
 #include <torch/torch.h>
 
-#include <cmath>
-
+#include "eval/metrics.hpp"
 #include "loss/fusion.hpp"
 
 namespace iesrgs::eval {
@@ -22,7 +21,7 @@ MaskCounts& MaskCounts::operator+=(const MaskCounts& other) {
 
 double MaskCounts::psnr(double squared_error) const {
   constexpr int kChannels = 3;
-  return -10.0 * std::log10(squared_error / double(kChannels * pixels));
+  return psnr_from_mse(squared_error / double(kChannels * pixels));
 }
 
 MaskCounts mask_counts(const torch::Tensor& internal_image, const torch::Tensor& external_image,

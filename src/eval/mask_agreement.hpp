@@ -28,11 +28,14 @@ struct MaskCounts {
   double recall() const { return share(both, truth_mask); }
   double iou() const { return share(both, mask + truth_mask - both); }
   double internal_closer_share() const { return share(internal_closer, mask); }
-  // PSNR of a reference over all pixels and channels, from one of the squared-error sums.
-  double psnr(double squared_error) const;
+  // PSNR of each reference over all pixels and channels.
+  double external_psnr() const { return psnr(external_error); }
+  double internal_psnr() const { return psnr(internal_error); }
+  double fused_psnr() const { return psnr(fused_error); }
 
  private:
   static double share(int64_t part, int64_t whole) { return whole ? double(part) / whole : 0; }
+  double psnr(double squared_error) const;
 };
 
 // Counts of one view; all three images (3, H, W) float in [0, 1].

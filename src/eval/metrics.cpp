@@ -42,7 +42,10 @@ double psnr(const Image& image, const Image& reference) {
     const double d = double(image.data[i]) - double(reference.data[i]);
     sum += d * d;
   }
-  const double mse = sum / double(image.data.size());
+  return psnr_from_mse(sum / double(image.data.size()));
+}
+
+double psnr_from_mse(double mse) {
   return mse > 0 ? -10.0 * std::log10(mse) : INFINITY;
 }
 

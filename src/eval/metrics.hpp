@@ -12,6 +12,8 @@ namespace iesrgs::eval {
 
 // Both images RGB (HWC) of the same size; throws Error otherwise.
 double psnr(const Image& image, const Image& reference);
+// PSNR of a mean squared error on values in [0, 1]; infinite for a perfect match.
+double psnr_from_mse(double mse);
 double ssim(const Image& image, const Image& reference);
 
 struct ViewMetrics {

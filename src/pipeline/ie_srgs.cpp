@@ -339,9 +339,9 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
                                {"recall", counts.recall()},
                                {"iou", counts.iou()},
                                {"internal_closer_share", counts.internal_closer_share()},
-                               {"psnr_external", counts.psnr(counts.external_error)},
-                               {"psnr_internal", counts.psnr(counts.internal_error)},
-                               {"psnr_fused", counts.psnr(counts.fused_error)}};
+                               {"psnr_external", counts.external_psnr()},
+                               {"psnr_internal", counts.internal_psnr()},
+                               {"psnr_fused", counts.fused_psnr()}};
   const fs::path path = o_.output / "diagnostics" / "mask_agreement.json";
   write_file_atomically(path, json.dump(2) + "\n");
   fmt::print(
@@ -351,9 +351,8 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
       "references against the HR truth: E_image {:.2f} dB, I_image {:.2f} dB, fused by M {:.2f} "
       "dB\n",
       100 * counts.mask_share(), 100 * counts.truth_mask_share(), counts.iou(), counts.precision(),
-      counts.recall(), 100 * counts.internal_closer_share(), path.string(),
-      counts.psnr(counts.external_error), counts.psnr(counts.internal_error),
-      counts.psnr(counts.fused_error));
+      counts.recall(), 100 * counts.internal_closer_share(), path.string(), counts.external_psnr(),
+      counts.internal_psnr(), counts.fused_psnr());
 }
 
 RunResult Pipeline::run() {

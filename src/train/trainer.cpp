@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "eval/metrics.hpp"
 #include "gs/checkpoint.hpp"
 #include "gs/densify.hpp"
 #include "loss/autograd.hpp"
@@ -62,7 +63,7 @@ std::string tensor_bytes(const torch::Tensor& tensor) {
 
 double psnr(const torch::Tensor& image, const torch::Tensor& target) {
   const double mse = (image.clamp(0, 1) - target).square().mean().item<double>();
-  return -10.0 * std::log10(std::max(mse, 1e-20));
+  return eval::psnr_from_mse(std::max(mse, 1e-20));
 }
 
 bool all_finite(const gs::GaussianModel& model) {

@@ -38,7 +38,7 @@ TEST(MaskAgreement, MaskPicksTheWrongInternalPixels) {
   EXPECT_DOUBLE_EQ(counts.recall(), 0);  // an empty G: no pixel to find
   EXPECT_DOUBLE_EQ(counts.internal_closer_share(), 0);
   // The fused reference takes the one wrong pixel: 3 of 48 values off by 0.4, MSE 0.01.
-  EXPECT_NEAR(counts.psnr(counts.fused_error), 20, 1e-4);
+  EXPECT_NEAR(counts.fused_psnr(), 20, 1e-4);
   EXPECT_EQ(counts.external_error, 0);
 }
 
