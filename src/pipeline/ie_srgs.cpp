@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -17,6 +18,7 @@
 #include "pipeline/fusion_stage.hpp"
 #include "pipeline/internal_stage.hpp"
 #include "pipeline/render_views.hpp"
+#include "pipeline/stage_record.hpp"
 #include "train/progress.hpp"
 #include "train/session.hpp"
 
@@ -57,10 +59,49 @@ constexpr RowSpec kRows[] = {
     {"hr", "HR upper bound", Source::HighRes, TextureGuidance::External, false, false},
 };
 
-const RowSpec& row_spec(const std::string& id) {
+const RowSpec* find_row(const std::string& id) {
   for (const RowSpec& row : kRows)
-    if (id == row.id) return row;
+    if (id == row.id) return &row;
+  return nullptr;
+}
+
+const RowSpec& row_spec(const std::string& id) {
+  if (const RowSpec* row = find_row(id)) return *row;
   fail("unknown row '{}'; rows: {}", id, describe_rows());
+}
+
+size_t table_position(const std::string& id) {
+  return size_t(find_row(id) - std::begin(kRows));
+}
+
+nlohmann::json row_json(const RowResult& row) {
+  nlohmann::json entry = {{"row", row.id},
+                          {"label", row.label},
+                          {"train_seconds", row.train_seconds},
+                          {"fps", row.fps}};
+  if (row.from_earlier_run) entry["from_earlier_run"] = true;
+  if (row.evaluated) {
+    entry["psnr"] = row.mean.psnr;
+    entry["ssim"] = row.mean.ssim;
+    if (row.mean.lpips) entry["lpips"] = *row.mean.lpips;
+  }
+  return entry;
+}
+
+RowResult row_from_json(const nlohmann::json& entry) {
+  RowResult row;
+  row.id = entry.value("row", "");
+  row.label = entry.value("label", "");
+  row.train_seconds = entry.value("train_seconds", 0.0);
+  row.fps = entry.value("fps", 0.0);
+  row.from_earlier_run = entry.value("from_earlier_run", false);
+  row.evaluated = entry.contains("psnr") && entry.contains("ssim");
+  if (row.evaluated) {
+    row.mean.psnr = entry.value("psnr", 0.0);
+    row.mean.ssim = entry.value("ssim", 0.0);
+    if (entry.contains("lpips")) row.mean.lpips = entry.value("lpips", 0.0);
+  }
+  return row;
 }
 
 double elapsed_since(std::chrono::steady_clock::time_point start) {
@@ -74,6 +115,7 @@ class Pipeline {
 
  private:
   bool any_row(Source source) const;
+  bool row_uses_internal(const RowSpec& row) const;
   bool rows_use_internal_references() const;
   void check_cached_inputs() const;
   void run_external_stages();
@@ -86,6 +128,8 @@ class Pipeline {
   gs::GaussianModel initial_hr_model() const;
   RowResult evaluate_row(const RowSpec& row, const gs::GaussianModel& model, const fs::path& dir);
   RowResult run_fusion_row(const RowSpec& row);
+  bool row_current(const RowSpec& row) const;
+  void keep_earlier_rows(RunResult& result) const;
   void write_fusion_diagnostics(const gs::GaussianModel& model, const FusionSetup& setup) const;
   void write_mask_agreement(const FusionSetup& setup) const;
   // The HR ground truth of training view i, (3, H, W); undefined when the run has none at
@@ -128,15 +172,15 @@ bool Pipeline::any_row(Source source) const {
   return false;
 }
 
+bool Pipeline::row_uses_internal(const RowSpec& row) const {
+  const loss::FusionWeights weights = row_weights(row);
+  return o_.init == "internal" || row.source == Source::Internal ||
+         weights.texture != TextureGuidance::External || weights.internal_depth > 0;
+}
+
 bool Pipeline::rows_use_internal_references() const {
-  if (o_.init == "internal") return true;
-  for (const std::string& id : rows_) {
-    const RowSpec& row = row_spec(id);
-    const loss::FusionWeights weights = row_weights(row);
-    if (row.source == Source::Internal || weights.texture != TextureGuidance::External ||
-        weights.internal_depth > 0)
-      return true;
-  }
+  for (const std::string& id : rows_)
+    if (row_uses_internal(row_spec(id))) return true;
   return false;
 }
 
@@ -252,7 +296,9 @@ nlohmann::json Pipeline::row_params(const RowSpec& row, const loss::FusionWeight
                           {"sr_weights", o_.external.sr_weights.string()},
                           {"depth_model", o_.external.depth_model},
                           {"depth_weights", o_.external.depth_weights.string()}};
-  if (internal_) params["internal_model_seconds"] = internal_->training.seconds;
+  // The internal model's recorded training time tells which model the row's references came from.
+  if (row_uses_internal(row))
+    params["internal_model_seconds"] = stage_seconds(o_.output / "internal");
   return params;
 }
 
@@ -375,9 +421,37 @@ RunResult Pipeline::run() {
     internal.train_seconds = internal_->training.seconds;
     result.rows.push_back(internal);
   }
+  if (o_.only == StageSelection::All) keep_earlier_rows(result);
   stages_["total_seconds_this_run"] = elapsed_since(start);
   result.stages = stages_;
   return result;
+}
+
+bool Pipeline::row_current(const RowSpec& row) const {
+  if (row_uses_internal(row) &&
+      !internal_stage_current(lr_scene_, o_.internal_config, o_.scale, o_.output / "internal"))
+    return false;
+  return row.source == Source::Internal ||
+         training_stage_current(o_.output / "rows" / row.id, row_params(row, row_weights(row)),
+                                o_.fusion_config);
+}
+
+// A rerun with fewer rows keeps the others of the folder's table, as long as their cached stage
+// is still the one these settings would reuse; rows trained under other settings are dropped.
+void Pipeline::keep_earlier_rows(RunResult& result) const {
+  const nlohmann::json earlier = read_stage_record(o_.output / "results.json");
+  for (const nlohmann::json& entry : earlier.value("rows", nlohmann::json::array())) {
+    const RowSpec* row = entry.is_object() ? find_row(entry.value("row", "")) : nullptr;
+    if (!row || std::find(rows_.begin(), rows_.end(), row->id) != rows_.end() || !row_current(*row))
+      continue;
+    RowResult kept = row_from_json(entry);
+    kept.label = row->label;
+    kept.from_earlier_run = true;
+    result.rows.push_back(kept);
+  }
+  std::stable_sort(result.rows.begin(), result.rows.end(), [](const auto& a, const auto& b) {
+    return table_position(a.id) < table_position(b.id);
+  });
 }
 
 std::string format_metric(const RowResult& row, double value, int decimals) {
@@ -387,11 +461,16 @@ std::string format_metric(const RowResult& row, double value, int decimals) {
 std::string results_markdown(const RunResult& result) {
   std::string md =
       "| row | PSNR | SSIM | LPIPS | HR training | FPS at HR |\n|---|---|---|---|---|---|\n";
-  for (const RowResult& row : result.rows)
-    md += fmt::format("| {} | {} | {} | {} | {} | {:.1f} |\n", row.label,
-                      format_metric(row, row.mean.psnr, 2), format_metric(row, row.mean.ssim, 4),
+  bool earlier = false;
+  for (const RowResult& row : result.rows) {
+    earlier = earlier || row.from_earlier_run;
+    md += fmt::format("| {}{} | {} | {} | {} | {} | {:.1f} |\n", row.label,
+                      row.from_earlier_run ? " *" : "", format_metric(row, row.mean.psnr, 2),
+                      format_metric(row, row.mean.ssim, 4),
                       row.mean.lpips ? fmt::format("{:.4f}", *row.mean.lpips) : "-",
                       train::format_duration(row.train_seconds), row.fps);
+  }
+  if (earlier) md += "\n\\* from an earlier run in this folder with the same settings\n";
   return md;
 }
 
@@ -399,16 +478,7 @@ void write_results(const fs::path& dir, const RunResult& result) {
   nlohmann::json json = {{"stages", result.stages}, {"rows", nlohmann::json::array()}};
   std::string csv = "row,label,psnr,ssim,lpips,train_seconds,fps\n";
   for (const RowResult& row : result.rows) {
-    nlohmann::json entry = {{"row", row.id},
-                            {"label", row.label},
-                            {"train_seconds", row.train_seconds},
-                            {"fps", row.fps}};
-    if (row.evaluated) {
-      entry["psnr"] = row.mean.psnr;
-      entry["ssim"] = row.mean.ssim;
-      if (row.mean.lpips) entry["lpips"] = *row.mean.lpips;
-    }
-    json["rows"].push_back(entry);
+    json["rows"].push_back(row_json(row));
     csv += fmt::format("{},\"{}\",{},{},{},{},{}\n", row.id, row.label,
                        format_metric(row, row.mean.psnr, 4), format_metric(row, row.mean.ssim, 5),
                        row.mean.lpips ? fmt::format("{:.5f}", *row.mean.lpips) : "",

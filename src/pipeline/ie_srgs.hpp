@@ -51,8 +51,9 @@ struct RowResult {
   std::string id, label;
   eval::ViewMetrics mean;  // over the test views; evaluated only with ground truth
   bool evaluated = false;
-  double train_seconds = 0;  // the row's own HR training (internal only: the LR model's)
-  double fps = 0;            // test-view rendering at HR
+  double train_seconds = 0;       // the row's own HR training (internal only: the LR model's)
+  double fps = 0;                 // test-view rendering at HR
+  bool from_earlier_run = false;  // kept from the folder's table, not run by this command
 };
 
 struct RunResult {
@@ -60,7 +61,8 @@ struct RunResult {
   nlohmann::json stages;  // seconds per stage
 };
 
-// Runs the selected stages and writes <output>/results.{json,csv,md} after the rows.
+// Runs the selected stages and writes <output>/results.{json,csv,md} after the rows, keeping the
+// rows of the folder's earlier table that these settings would reuse unchanged.
 RunResult run_ie_srgs(const RunOptions& options);
 
 }  // namespace iesrgs::pipeline

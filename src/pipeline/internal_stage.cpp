@@ -9,13 +9,24 @@
 
 namespace iesrgs::pipeline {
 
+namespace {
+
+nlohmann::json internal_params(const Scene& lr_scene) {
+  return {{"scene", lr_scene.root.string()}, {"downscale", lr_scene.downscale}};
+}
+
+// A finished training's recorded time tells which model the renders came from.
+nlohmann::json sr_params(double model_seconds, int scale) {
+  return {{"model_seconds", model_seconds}, {"scale", scale}};
+}
+
+}  // namespace
+
 InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
                                  const train::TrainConfig& config, int scale,
                                  const std::filesystem::path& dir) {
   train::TrainerSetup setup =
       train::scene_setup(lr_scene, lr_images, size_t(config.test_views), dir);
-  const nlohmann::json params = {{"scene", lr_scene.root.string()},
-                                 {"downscale", lr_scene.downscale}};
   const train::TrainConfig& c = config;
   fmt::print("internal model: {} LR views ({}x{}), K = {}, {} iterations\n",
              setup.train_views.size(), setup.train_views.front().camera.intrinsics.width,
@@ -25,19 +36,24 @@ InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
   for (const train::TrainView& view : setup.train_views) cameras.push_back(view.camera);
 
   InternalStage stage{
-      run_training_stage("internal model", params, config, std::move(setup),
+      run_training_stage("internal model", internal_params(lr_scene), config, std::move(setup),
                          [&] { return train::initial_model(lr_scene, config, {}); }),
       dir / "sr"};
-  // A finished training's recorded time tells which model the renders came from.
-  const nlohmann::json sr_params = {{"model_seconds", stage.training.seconds}, {"scale", scale}};
-  if (stage.training.cached && stage_finished(stage.sr_dir, sr_params)) return stage;
+  const nlohmann::json sr = sr_params(stage.training.seconds, scale);
+  if (stage.training.cached && stage_finished(stage.sr_dir, sr)) return stage;
   fmt::print("SR-splatting: rendering {} training views at x{}\n", cameras.size(), scale);
   const auto start = std::chrono::steady_clock::now();
   render_views_to(stage.sr_dir, stage.training.model, cameras, lr_scene.background, scale);
   stage.sr_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  record_stage(stage.sr_dir, sr_params, true, stage.sr_seconds);
+  record_stage(stage.sr_dir, sr, true, stage.sr_seconds);
   return stage;
+}
+
+bool internal_stage_current(const Scene& lr_scene, const train::TrainConfig& config, int scale,
+                            const std::filesystem::path& dir) {
+  return training_stage_current(dir, internal_params(lr_scene), config) &&
+         stage_finished(dir / "sr", sr_params(stage_seconds(dir), scale));
 }
 
 }  // namespace iesrgs::pipeline

@@ -24,4 +24,9 @@ InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
                                  const train::TrainConfig& config, int scale,
                                  const std::filesystem::path& dir);
 
+// Whether <dir> holds a finished internal model for these settings and its SR-splatting renders
+// at `scale`, so that run_internal_stage would only load them.
+bool internal_stage_current(const Scene& lr_scene, const train::TrainConfig& config, int scale,
+                            const std::filesystem::path& dir);
+
 }  // namespace iesrgs::pipeline

@@ -1,5 +1,6 @@
 #pragma once
-// The JSON records (stage.json, external.json) each cached stage keeps beside its outputs.
+// The JSON records (stage.json, external.json) each cached stage keeps beside its outputs, and a
+// run's results.json.
 #include <filesystem>
 #include <nlohmann/json.hpp>
 

@@ -19,6 +19,11 @@ nlohmann::json stage_json(const fs::path& dir) {
   return read_stage_record(dir / "stage.json");
 }
 
+// What a training stage's record must match: its inputs and its whole training config.
+nlohmann::json stage_identity(const nlohmann::json& params, const train::TrainConfig& config) {
+  return {{"stage", params}, {"training", train::to_json(config)}};
+}
+
 }  // namespace
 
 bool stage_finished(const fs::path& dir, const nlohmann::json& params) {
@@ -40,7 +45,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
                                const train::TrainConfig& config, train::TrainerSetup setup,
                                const std::function<gs::GaussianModel()>& initial_model) {
   const fs::path dir = setup.output_dir;
-  const nlohmann::json identity = {{"stage", params}, {"training", train::to_json(config)}};
+  const nlohmann::json identity = stage_identity(params, config);
   if (stage_finished(dir, identity)) {
     fmt::print("{}: reusing the finished model in {}\n", name, dir.string());
     return {gs::model_from_splat_cloud(read_ply(dir / "point_cloud.ply")), stage_seconds(dir),
@@ -64,6 +69,11 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   fmt::print("{}: {} Gaussians after {} ({:.2f} it/s)\n", name, summary.gaussians,
              train::format_duration(summary.seconds), summary.iterations_per_second);
   return {trainer.model(), summary.seconds, false};
+}
+
+bool training_stage_current(const fs::path& dir, const nlohmann::json& params,
+                            const train::TrainConfig& config) {
+  return stage_finished(dir, stage_identity(params, config));
 }
 
 }  // namespace iesrgs::pipeline

@@ -28,6 +28,11 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
                                const train::TrainConfig& config, train::TrainerSetup setup,
                                const std::function<gs::GaussianModel()>& initial_model);
 
+// Whether <dir> holds a finished stage for these parameters, which run_training_stage would load
+// instead of training.
+bool training_stage_current(const std::filesystem::path& dir, const nlohmann::json& params,
+                            const train::TrainConfig& config);
+
 // <dir>/stage.json of any stage: written on completion with its parameters and running time.
 bool stage_finished(const std::filesystem::path& dir, const nlohmann::json& params);
 double stage_seconds(const std::filesystem::path& dir);

@@ -2,6 +2,10 @@
 // results and diagnostics are written, a rerun reuses the cached stages, and misuse is reported.
 #include <gtest/gtest.h>
 
+#include <string>
+#include <utility>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.hpp"
@@ -64,6 +68,31 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
   ASSERT_EQ(second.status, 0) << second.output;
   EXPECT_TRUE(contains(second.output, "reusing the finished model")) << second.output;
   EXPECT_FALSE(contains(second.output, "it/s |")) << second.output;
+
+  // Rerunning one row keeps the rest of the folder's table.
+  using Table = std::vector<std::pair<std::string, bool>>;
+  const std::string external_only =
+      "run " + scene + " -o " + out + " --rows external" + kTinySchedule;
+  const CliRun one = iesrgs(external_only);
+  ASSERT_EQ(one.status, 0) << one.output;
+  EXPECT_FALSE(contains(one.output, "it/s |")) << one.output;
+  const auto table = [&] {
+    const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+    Table rows;  // in table order: row, kept from an earlier run
+    for (const auto& row : results["rows"])
+      rows.emplace_back(row["row"], row.value("from_earlier_run", false));
+    return rows;
+  };
+  const Table kept = {{"bicubic", true}, {"internal", true}, {"external", false},
+                      {"joint", true},   {"ie-srgs", true},  {"hr", true}};
+  EXPECT_EQ(table(), kept);
+  EXPECT_TRUE(contains(read_file(dir / "run" / "results.md"), "from an earlier run"));
+
+  // Another internal model: the rows built on it leave the table, the others stay.
+  const CliRun other = iesrgs(external_only + " --internal-set seed=7");
+  ASSERT_EQ(other.status, 0) << other.output;
+  const Table independent = {{"bicubic", true}, {"external", false}, {"hr", true}};
+  EXPECT_EQ(table(), independent);
 }
 
 TEST(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
