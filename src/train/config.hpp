@@ -28,7 +28,7 @@ struct TrainConfig {
   bool absolute_gradients = false;
   double percent_dense = 0.01;
   double min_opacity = 0.005;
-  float max_screen_size = 20;         // pixels, enforced after the first opacity reset
+  float max_screen_size = 20;  // pixels, after the first opacity reset; 0: no large-splat pruning
   int64_t filter_update_every = 100;  // Mip-Splatting 3D filter, once densification has stopped
 
   gs::LearningRates learning_rates;

@@ -21,6 +21,7 @@ TEST(TrainConfig, PaperPresetIsMethodSchedule) {
   EXPECT_EQ(c.sh_increase_every, 1000);
   EXPECT_DOUBLE_EQ(c.grad_threshold, 2e-4);
   EXPECT_EQ(c.learning_rates.position_max_steps, 30000);
+  EXPECT_EQ(c.max_screen_size, 20);
 }
 
 TEST(TrainConfig, ShorterRunsScaleTheScheduleTogether) {
@@ -34,6 +35,10 @@ TEST(TrainConfig, ShorterRunsScaleTheScheduleTogether) {
   EXPECT_EQ(c.densify_every, 100);  // the rhythm of densification stays
   EXPECT_EQ(make_preset("cpu").iterations, 10000);
   EXPECT_EQ(make_preset("fast").iterations, 3000);
+  // Short presets prune no large splats (see make_preset); --iterations alone keeps 3DGS's rule.
+  EXPECT_EQ(make_preset("cpu").max_screen_size, 0);
+  EXPECT_EQ(make_preset("fast", 500).max_screen_size, 0);
+  EXPECT_EQ(c.max_screen_size, 20);
 }
 
 TEST(TrainConfig, JsonRoundTripsEveryField) {
