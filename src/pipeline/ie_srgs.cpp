@@ -437,17 +437,24 @@ bool Pipeline::row_current(const RowSpec& row) const {
 }
 
 // A rerun with fewer rows keeps the others of the folder's table, as long as their cached stage
-// is still the one these settings would reuse; rows trained under other settings are dropped.
+// is still the one these settings would reuse; rows trained under other settings are dropped, and
+// so are entries a damaged results.json garbled.
 void Pipeline::keep_earlier_rows(RunResult& result) const {
   const nlohmann::json earlier = read_stage_record(o_.output / "results.json");
-  for (const nlohmann::json& entry : earlier.value("rows", nlohmann::json::array())) {
-    const RowSpec* row = entry.is_object() ? find_row(entry.value("row", "")) : nullptr;
-    if (!row || std::find(rows_.begin(), rows_.end(), row->id) != rows_.end() || !row_current(*row))
+  const nlohmann::json rows = earlier.value("rows", nlohmann::json::array());
+  for (const nlohmann::json& entry : rows.is_array() ? rows : nlohmann::json::array()) {
+    try {
+      const RowSpec* row = find_row(entry.at("row").get<std::string>());
+      if (!row || std::find(rows_.begin(), rows_.end(), row->id) != rows_.end() ||
+          !row_current(*row))
+        continue;
+      RowResult kept = row_from_json(entry);
+      kept.label = row->label;
+      kept.from_earlier_run = true;
+      result.rows.push_back(kept);
+    } catch (const nlohmann::json::exception&) {
       continue;
-    RowResult kept = row_from_json(entry);
-    kept.label = row->label;
-    kept.from_earlier_run = true;
-    result.rows.push_back(kept);
+    }
   }
   std::stable_sort(result.rows.begin(), result.rows.end(), [](const auto& a, const auto& b) {
     return table_position(a.id) < table_position(b.id);
