@@ -88,13 +88,14 @@ nlohmann::json row_json(const RowResult& row) {
   return entry;
 }
 
-RowResult row_from_json(const nlohmann::json& entry) {
+// A row of an earlier results.json, which names it; id and label come from the row's spec.
+RowResult earlier_row(const RowSpec& spec, const nlohmann::json& entry) {
   RowResult row;
-  row.id = entry.value("row", "");
-  row.label = entry.value("label", "");
+  row.id = spec.id;
+  row.label = spec.label;
+  row.from_earlier_run = true;
   row.train_seconds = entry.value("train_seconds", 0.0);
   row.fps = entry.value("fps", 0.0);
-  row.from_earlier_run = entry.value("from_earlier_run", false);
   row.evaluated = entry.contains("psnr") && entry.contains("ssim");
   if (row.evaluated) {
     row.mean.psnr = entry.value("psnr", 0.0);
@@ -448,10 +449,7 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
       if (!row || std::find(rows_.begin(), rows_.end(), row->id) != rows_.end() ||
           !row_current(*row))
         continue;
-      RowResult kept = row_from_json(entry);
-      kept.label = row->label;
-      kept.from_earlier_run = true;
-      result.rows.push_back(kept);
+      result.rows.push_back(earlier_row(*row, entry));
     } catch (const nlohmann::json::exception&) {
       continue;
     }
