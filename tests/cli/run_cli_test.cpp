@@ -95,8 +95,9 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
   EXPECT_EQ(table(), independent);
 
   // A damaged table costs only the rows it garbled.
-  write_file_atomically(dir / "run" / "results.json",
-                        R"({"rows": [{"row": 5}, "x", {"row": "hr", "psnr": "bad", "ssim": 0.9}]})");
+  write_file_atomically(
+      dir / "run" / "results.json",
+      R"({"rows": [{"row": 5}, "x", {"row": "hr", "psnr": "bad", "ssim": 0.9}]})");
   const CliRun damaged = iesrgs(external_only + " --internal-set seed=7");
   ASSERT_EQ(damaged.status, 0) << damaged.output;
   EXPECT_EQ(table(), (Table{{"external", false}}));

@@ -7,12 +7,12 @@
 
 #include "io/atomic_file.hpp"
 #include "io/camera.hpp"
+#include "io/colmap.hpp"
 #include "io/image.hpp"
 #include "io/npy.hpp"
+#include "io/scene.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
-#include "io/colmap.hpp"
-#include "io/scene.hpp"
 #include "synth/dataset_writer.hpp"
 #include "synth/renderer.hpp"
 

@@ -1,8 +1,8 @@
 #include "priors/sr/bicubic.hpp"
 
 #include "core/error.hpp"
-#include "io/resize.hpp"
 #include "io/image_tensor.hpp"
+#include "io/resize.hpp"
 
 namespace iesrgs::priors::sr {
 

@@ -8,8 +8,8 @@
 #include <iterator>
 
 #include "core/error.hpp"
-#include "priors/keras_model.hpp"
 #include "io/image_tensor.hpp"
+#include "priors/keras_model.hpp"
 
 namespace iesrgs::priors::sr {
 

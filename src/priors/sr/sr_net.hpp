@@ -10,14 +10,14 @@
 namespace iesrgs::priors::sr {
 
 class SrNet {
-public:
-    virtual ~SrNet() = default;
-    virtual std::string name() const = 0;
-    virtual int scale() const = 0;
-    // RGB in [0, 1], shape (1, 3, H, W) -> (1, 3, scale * H, scale * W), under
-    // torch::NoGradGuard. Any padding the network needs (e.g. to a window
-    // multiple) happens inside and is cropped off again.
-    virtual torch::Tensor upscale(const torch::Tensor& rgb) = 0;
+ public:
+  virtual ~SrNet() = default;
+  virtual std::string name() const = 0;
+  virtual int scale() const = 0;
+  // RGB in [0, 1], shape (1, 3, H, W) -> (1, 3, scale * H, scale * W), under
+  // torch::NoGradGuard. Any padding the network needs (e.g. to a window
+  // multiple) happens inside and is cropped off again.
+  virtual torch::Tensor upscale(const torch::Tensor& rgb) = 0;
 };
 
 // Builds the backend `model` (bicubic, safmn, imdn, pan, swinir, esrgan-slim,
