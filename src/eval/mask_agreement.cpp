@@ -9,6 +9,7 @@ namespace iesrgs::eval {
 
 MaskCounts& MaskCounts::operator+=(const MaskCounts& other) {
   pixels += other.pixels;
+  values += other.values;
   mask += other.mask;
   truth_mask += other.truth_mask;
   both += other.both;
@@ -20,8 +21,7 @@ MaskCounts& MaskCounts::operator+=(const MaskCounts& other) {
 }
 
 double MaskCounts::psnr(double squared_error) const {
-  constexpr int kChannels = 3;
-  return psnr_from_mse(squared_error / double(kChannels * pixels));
+  return psnr_from_mse(squared_error / double(values));
 }
 
 MaskCounts mask_counts(const torch::Tensor& internal_image, const torch::Tensor& external_image,
@@ -37,6 +37,7 @@ MaskCounts mask_counts(const torch::Tensor& internal_image, const torch::Tensor&
   };
   MaskCounts counts;
   counts.pixels = mask.numel();
+  counts.values = truth.numel();
   counts.mask = count(mask);
   counts.truth_mask = count(truth_mask);
   counts.both = count(mask & truth_mask);

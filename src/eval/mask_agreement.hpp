@@ -14,6 +14,7 @@ namespace iesrgs::eval {
 // Pixel counts, summed over views.
 struct MaskCounts {
   int64_t pixels = 0;
+  int64_t values = 0;           // pixels times channels, what the squared errors sum over
   int64_t mask = 0;             // |M|
   int64_t truth_mask = 0;       // |G|
   int64_t both = 0;             // |M and G|
@@ -38,7 +39,7 @@ struct MaskCounts {
   double psnr(double squared_error) const;
 };
 
-// Counts of one view; all three images (3, H, W) float in [0, 1].
+// Counts of one view; all three images (C, H, W) float in [0, 1].
 MaskCounts mask_counts(const torch::Tensor& internal_image, const torch::Tensor& external_image,
                        const torch::Tensor& truth, double threshold);
 

@@ -42,11 +42,21 @@ TEST(MaskAgreement, MaskPicksTheWrongInternalPixels) {
   EXPECT_EQ(counts.external_error, 0);
 }
 
+TEST(MaskAgreement, PsnrAveragesOverTheImagesOwnChannels) {
+  const torch::Tensor truth = torch::full({1, 4, 4}, 0.5f);
+  torch::Tensor internal = truth.clone();
+  internal.index_put_({0, 1, 1}, 0.1f);  // 1 of 16 values off by 0.4: MSE 0.01
+  const MaskCounts counts = mask_counts(internal, truth, truth, 0.6);
+  EXPECT_EQ(counts.values, 16);
+  EXPECT_NEAR(counts.internal_psnr(), 20, 1e-4);
+}
+
 TEST(MaskAgreement, CountsAddUp) {
   const torch::Tensor truth = image_with({}, 0);
   MaskCounts sum = mask_counts(truth, image_with({3, 9}, 0.05f), truth, 0.6);
   sum += mask_counts(image_with({5}, 0.1f), truth, truth, 0.6);
   EXPECT_EQ(sum.pixels, 32);
+  EXPECT_EQ(sum.values, 96);
   EXPECT_EQ(sum.mask, 3);
   EXPECT_EQ(sum.both, 2);
   EXPECT_DOUBLE_EQ(sum.precision(), 2.0 / 3);
