@@ -4,6 +4,8 @@
 
 #include <cstdlib>
 #include <nlohmann/json.hpp>
+#include <ostream>
+#include <string>
 
 #include "eval/metrics.hpp"
 #include "io/atomic_file.hpp"
@@ -151,6 +153,10 @@ struct LegoMargin {
   double decibels;  // measured on r_0: slim +0.16, medium +0.44, thick +1.50
 };
 
+void PrintTo(const LegoMargin& margin, std::ostream* out) {
+  *out << margin.variant << " +" << margin.decibels << " dB";
+}
+
 class EsrganOnLego : public ::testing::TestWithParam<LegoMargin> {};
 
 // The benchmark protocol: a Blender view composited on white, bicubic down x4, then back up.
@@ -171,7 +177,8 @@ TEST_P(EsrganOnLego, BeatsBicubicAtX4) {
 
 INSTANTIATE_TEST_SUITE_P(Esrgan, EsrganOnLego,
                          ::testing::Values(LegoMargin{"slim", 0.1}, LegoMargin{"medium", 0.3},
-                                           LegoMargin{"thick", 1.0}));
+                                           LegoMargin{"thick", 1.0}),
+                         [](const auto& info) { return std::string(info.param.variant); });
 
 }  // namespace
 }  // namespace iesrgs::priors::sr
