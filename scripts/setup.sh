@@ -15,18 +15,7 @@ PACKAGES=(
 # npm fetches the default super-resolution model (below); a Node.js install may already ship it.
 command -v npm >/dev/null || PACKAGES+=(npm)
 
-missing=()
-for package in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" ||
-    missing+=("$package")
-done
-if ((${#missing[@]})); then
-  echo "setup: installing ${missing[*]}"
-  sudo=""
-  [ "$(id -u)" -eq 0 ] || sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+scripts/apt-install.sh "${PACKAGES[@]}"
 
 # The default super-resolution prior: the MIT-licensed pre-trained ESRGAN models of UpscalerJS
 # (TensorFlow.js layers models), looked up at run time in $IESRGS_NPM_DIR or third_party/npm.
