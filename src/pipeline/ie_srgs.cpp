@@ -88,11 +88,12 @@ nlohmann::json row_json(const RowResult& row) {
   return entry;
 }
 
-// A row of an earlier results.json, which names it; id and label come from the row's spec.
-RowResult earlier_row(const RowSpec& spec, const nlohmann::json& entry) {
+// A row of an earlier results.json, which names it; kept only under the current settings, so its
+// label is the one they give.
+RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry) {
   RowResult row;
   row.id = spec.id;
-  row.label = spec.label;
+  row.label = std::move(label);
   row.from_earlier_run = true;
   row.train_seconds = entry.value("train_seconds", 0.0);
   row.fps = entry.value("fps", 0.0);
@@ -124,6 +125,7 @@ class Pipeline {
   std::vector<Camera> hr_train_cameras() const;
   std::vector<Camera> test_cameras() const;
   loss::FusionWeights row_weights(const RowSpec& row) const;
+  std::string row_label(const RowSpec& row) const;
   FusionSetup fusion_setup(const RowSpec& row, const loss::FusionWeights& weights) const;
   nlohmann::json row_params(const RowSpec& row, const loss::FusionWeights& weights) const;
   gs::GaussianModel initial_hr_model() const;
@@ -248,6 +250,13 @@ loss::FusionWeights Pipeline::row_weights(const RowSpec& row) const {
   return weights;
 }
 
+// The ie-srgs row takes --texture: off the mask, its label says what supervised it instead.
+std::string Pipeline::row_label(const RowSpec& row) const {
+  const TextureGuidance texture = row_weights(row).texture;
+  if (texture == row.texture) return row.label;
+  return fmt::format("IE-SRGS, {} texture (no mask)", loss::texture_guidance_name(texture));
+}
+
 FusionSetup Pipeline::fusion_setup(const RowSpec& row, const loss::FusionWeights& weights) const {
   FusionSetup setup;
   setup.weights = weights;
@@ -320,7 +329,7 @@ RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& mo
   stages_["evaluation_seconds"][row.id] = elapsed_since(start);
   RowResult result;
   result.id = row.id;
-  result.label = row.label;
+  result.label = row_label(row);
   result.evaluated = !evaluation.report.views.empty();
   if (result.evaluated) result.mean = evaluation.report.mean();
   result.fps = evaluation.seconds_per_view > 0 ? 1 / evaluation.seconds_per_view : 0;
@@ -330,7 +339,7 @@ RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& mo
 RowResult Pipeline::run_fusion_row(const RowSpec& row) {
   const loss::FusionWeights weights = row_weights(row);
   const fs::path dir = o_.output / "rows" / row.id;
-  fmt::print("\n== row {}: {} ==\n", row.id, row.label);
+  fmt::print("\n== row {}: {} ==\n", row.id, row_label(row));
   FusionSetup setup = fusion_setup(row, weights);
   const FusionSetup diagnostics_setup = std::string(row.id) == "ie-srgs" ? setup : FusionSetup{};
   const StageResult stage =
@@ -417,7 +426,7 @@ RunResult Pipeline::run() {
       result.rows.push_back(run_fusion_row(row));
       continue;
     }
-    fmt::print("\n== row {}: {} ==\n", row.id, row.label);
+    fmt::print("\n== row {}: {} ==\n", row.id, row_label(row));
     RowResult internal = evaluate_row(row, internal_->training.model, o_.output / "rows" / row.id);
     internal.train_seconds = internal_->training.seconds;
     result.rows.push_back(internal);
@@ -449,7 +458,7 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
       if (!row || std::find(rows_.begin(), rows_.end(), row->id) != rows_.end() ||
           !row_current(*row))
         continue;
-      result.rows.push_back(earlier_row(*row, entry));
+      result.rows.push_back(earlier_row(*row, row_label(*row), entry));
     } catch (const nlohmann::json::exception&) {
       continue;
     }

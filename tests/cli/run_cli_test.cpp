@@ -121,6 +121,19 @@ TEST(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_FALSE(std::filesystem::exists(dir / "run" / "results.json"));
 }
 
+TEST(RunCli, IeSrgsRowOffTheMaskIsLabelledByItsTexture) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 1 --seed 3").status, 0);
+  const CliRun run =
+      iesrgs("run " + scene + " -o " + out + " --rows ie-srgs --texture external" + kTinySchedule);
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(contains(run.output, "== row ie-srgs: IE-SRGS, external texture (no mask) =="))
+      << run.output;
+  const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+  EXPECT_EQ(results["rows"][0]["label"], "IE-SRGS, external texture (no mask)");
+}
+
 TEST(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
   TempDir dir;
   const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
