@@ -24,13 +24,7 @@ if [[ ${#names[@]} -eq 0 ]]; then
   exit 1
 fi
 
-if ! command -v "${CXX:-clang++}" >/dev/null; then
-  echo "fuzz: installing clang (libFuzzer)"
-  sudo=""
-  [ "$(id -u)" -eq 0 ] || sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends clang
-fi
+command -v "${CXX:-clang++}" >/dev/null || "$root/scripts/apt-install.sh" clang  # with libFuzzer
 
 targets=()
 for name in "${names[@]}"; do targets+=("iesrgs_${name}_fuzzer"); done
