@@ -116,7 +116,7 @@ nlohmann::json to_json(const TrainConfig& config) {
 void apply_json(TrainConfig& config, const nlohmann::json& json, const std::string& origin) {
   if (!json.is_object()) fail("{}: a training config must be a JSON object", origin);
   for (const auto& item : json.items()) {
-    // Named copies, not structured bindings: clang 14 cannot capture those in the lambda.
+    // Named references, not structured bindings: clang 14 cannot capture those in the lambda.
     const std::string& key = item.key();
     const nlohmann::json& value = item.value();
     bool known = false;
