@@ -59,12 +59,24 @@ class Esrgan final : public SrNet {
   keras::LayersModel model_;
 };
 
+fs::path npm_dir() {
+  const char* dir = std::getenv("IESRGS_NPM_DIR");
+  return dir && *dir ? fs::path(dir) : fs::path(IESRGS_DEFAULT_NPM_DIR);
+}
+
+// Setup installs only the slim package, so the others need the npm command spelled out; the
+// loader was checked against the 1.0.0 packages.
+std::string install_hint(const std::string& name, bool default_location) {
+  if (!default_location) return fmt::format("the folder is not an @upscalerjs/{} package", name);
+  return fmt::format("npm install --prefix {} @upscalerjs/{}@1.0.0 installs it{}",
+                     npm_dir().string(), name,
+                     name == "esrgan-slim" ? ", and so does scripts/setup.sh" : "");
+}
+
 }  // namespace
 
 fs::path default_esrgan_package_dir(const std::string& variant) {
-  const char* npm_dir = std::getenv("IESRGS_NPM_DIR");
-  const fs::path root = npm_dir && *npm_dir ? fs::path(npm_dir) : fs::path(IESRGS_DEFAULT_NPM_DIR);
-  return root / "node_modules" / "@upscalerjs" / ("esrgan-" + variant);
+  return npm_dir() / "node_modules" / "@upscalerjs" / ("esrgan-" + variant);
 }
 
 std::unique_ptr<SrNet> make_esrgan(const std::string& variant, int scale,
@@ -76,9 +88,8 @@ std::unique_ptr<SrNet> make_esrgan(const std::string& variant, int scale,
   const fs::path folder = package_dir.empty() ? default_esrgan_package_dir(variant) : package_dir;
   const fs::path model_json = folder / "models" / fmt::format("x{}", scale) / "model.json";
   if (!fs::exists(model_json))
-    fail_file(model_json, fmt::format("{} is not installed (run scripts/setup.sh, or npm install "
-                                      "@upscalerjs/{} into $IESRGS_NPM_DIR)",
-                                      name, name));
+    fail_file(model_json, fmt::format("{} is not installed ({})", name,
+                                      install_hint(name, package_dir.empty())));
   keras::LayersModel model = keras::LayersModel::load(model_json);
   if (model.input_channels() != 3) fail_file(model_json, "the model does not take RGB input");
   return std::make_unique<Esrgan>(name, scale, found.pixel_range, std::move(model));

@@ -139,6 +139,22 @@ TEST(Esrgan, RejectsUnknownVariantsScalesAndMissingPackages) {
             0u);
 }
 
+TEST(Esrgan, MissingPackageErrorSaysHowToInstallIt) {
+  const char* saved = std::getenv("IESRGS_NPM_DIR");
+  const std::string previous = saved ? saved : "";
+  TempDir dir;
+  ::setenv("IESRGS_NPM_DIR", dir.path().c_str(), 1);
+  const std::string thick = error_message([] { make_esrgan("thick", 4, {}); });
+  const std::string slim = error_message([] { make_esrgan("slim", 4, {}); });
+  saved ? ::setenv("IESRGS_NPM_DIR", previous.c_str(), 1) : ::unsetenv("IESRGS_NPM_DIR");
+  const std::string command = "npm install --prefix " + dir.path().string() + " @upscalerjs/";
+  EXPECT_NE(thick.find(command + "esrgan-thick@1.0.0 installs it)"), std::string::npos) << thick;
+  EXPECT_EQ(thick.find("setup.sh"), std::string::npos) << thick;
+  EXPECT_NE(slim.find(command + "esrgan-slim@1.0.0 installs it, and so does scripts/setup.sh"),
+            std::string::npos)
+      << slim;
+}
+
 TEST(Esrgan, PackageDirectoryFollowsTheEnvironment) {
   const char* saved = std::getenv("IESRGS_NPM_DIR");
   const std::string previous = saved ? saved : "";
