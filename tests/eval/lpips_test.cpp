@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -15,6 +14,7 @@
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "support/expect_error.hpp"
+#include "support/scoped_env.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs::eval {
@@ -22,6 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::error_message;
+using testing::ScopedEnv;
 
 // Written by tests/data/eval/lpips/make_lpips_fixtures.py from the official LPIPS code: three
 // image pairs and the official distances for each, with the real linear heads and the stand-in
@@ -192,28 +193,6 @@ TEST(Lpips, ParsesTheOfficialNetworkNames) {
 }
 
 // Sets an environment variable (or unsets it for nullopt) for one scope.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, std::optional<std::string> value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    set(value);
-  }
-  ~ScopedEnv() { set(old_); }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  void set(const std::optional<std::string>& value) {
-    if (value) {
-      setenv(name_, value->c_str(), 1);
-    } else {
-      unsetenv(name_);
-    }
-  }
-  const char* name_;
-  std::optional<std::string> old_;
-};
-
 TEST(Lpips, DefaultWeightsFollowTheWeightsDirectoryThenTorchsCache) {
   {
     ScopedEnv weights("IESRGS_WEIGHTS_DIR", "/models");

@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
@@ -15,6 +14,7 @@
 #include "io/resize.hpp"
 #include "priors/keras_model.hpp"
 #include "support/expect_error.hpp"
+#include "support/scoped_env.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs::priors::sr {
@@ -23,6 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 using iesrgs::testing::error_message;
+using iesrgs::testing::ScopedEnv;
 using iesrgs::testing::TempDir;
 using iesrgs::testing::write_text;
 
@@ -140,13 +141,10 @@ TEST(Esrgan, RejectsUnknownVariantsScalesAndMissingPackages) {
 }
 
 TEST(Esrgan, MissingPackageErrorSaysHowToInstallIt) {
-  const char* saved = std::getenv("IESRGS_NPM_DIR");
-  const std::string previous = saved ? saved : "";
   TempDir dir;
-  ::setenv("IESRGS_NPM_DIR", dir.path().c_str(), 1);
+  const ScopedEnv npm_dir("IESRGS_NPM_DIR", dir.path().string());
   const std::string thick = error_message([] { make_esrgan("thick", 4, {}); });
   const std::string slim = error_message([] { make_esrgan("slim", 4, {}); });
-  saved ? ::setenv("IESRGS_NPM_DIR", previous.c_str(), 1) : ::unsetenv("IESRGS_NPM_DIR");
   const std::string command = "npm install --prefix " + dir.path().string() + " @upscalerjs/";
   EXPECT_NE(thick.find(command + "esrgan-thick@1.0.0 installs it)"), std::string::npos) << thick;
   EXPECT_EQ(thick.find("setup.sh"), std::string::npos) << thick;
@@ -156,12 +154,9 @@ TEST(Esrgan, MissingPackageErrorSaysHowToInstallIt) {
 }
 
 TEST(Esrgan, PackageDirectoryFollowsTheEnvironment) {
-  const char* saved = std::getenv("IESRGS_NPM_DIR");
-  const std::string previous = saved ? saved : "";
-  ::setenv("IESRGS_NPM_DIR", "/opt/models", 1);
+  const ScopedEnv npm_dir("IESRGS_NPM_DIR", "/opt/models");
   EXPECT_EQ(default_esrgan_package_dir("medium"),
             fs::path("/opt/models/node_modules/@upscalerjs/esrgan-medium"));
-  saved ? ::setenv("IESRGS_NPM_DIR", previous.c_str(), 1) : ::unsetenv("IESRGS_NPM_DIR");
 }
 
 struct LegoMargin {

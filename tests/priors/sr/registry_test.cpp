@@ -1,7 +1,6 @@
 #include "priors/sr/registry.hpp"
 
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <cstdio>
 #include <map>
@@ -9,6 +8,7 @@
 
 #include "priors/sr/sr_test_support.hpp"
 #include "support/expect_error.hpp"
+#include "support/scoped_env.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs::priors::sr {
@@ -16,28 +16,8 @@ namespace {
 
 using iesrgs::testing::contains;
 using iesrgs::testing::error_message;
+using iesrgs::testing::ScopedEnv;
 using iesrgs::testing::TempDir;
-
-// Sets (or with no value unsets) IESRGS_WEIGHTS_DIR for the scope and restores what was there.
-class WeightsDirOverride {
- public:
-  explicit WeightsDirOverride(const std::optional<std::filesystem::path>& dir) {
-    if (const char* old = std::getenv(kName)) old_ = old;
-    set(dir ? std::optional<std::string>(dir->string()) : std::nullopt);
-  }
-  ~WeightsDirOverride() { set(old_); }
-
- private:
-  static void set(const std::optional<std::string>& value) {
-    if (value)
-      ::setenv(kName, value->c_str(), 1);
-    else
-      ::unsetenv(kName);
-  }
-
-  static constexpr const char* kName = "IESRGS_WEIGHTS_DIR";
-  std::optional<std::string> old_;
-};
 
 TEST(SrRegistry, KnowsTheBuiltInModels) {
   const std::vector<std::string>& names = sr_model_names();
@@ -56,19 +36,19 @@ TEST(SrRegistry, UnknownModelAndBadScaleAreErrors) {
 }
 
 TEST(SrRegistry, DefaultWeightsFollowTheEnvironment) {
-  WeightsDirOverride weights("/opt/weights");
+  ScopedEnv weights("IESRGS_WEIGHTS_DIR", "/opt/weights");
   EXPECT_EQ(default_sr_weights("safmn", 4), "/opt/weights/sr/SAFMN_x4.pth");
   EXPECT_EQ(default_sr_weights("pan", 2), "/opt/weights/sr/PAN_x2.pth");
 }
 
 TEST(SrRegistry, DefaultWeightsAreTheDevelopmentDataOtherwise) {
-  WeightsDirOverride weights(std::nullopt);
+  ScopedEnv weights("IESRGS_WEIGHTS_DIR", std::nullopt);
   EXPECT_EQ(default_weights_dir(), std::filesystem::path(IESRGS_SHARED_DATA) / "weights");
 }
 
 TEST(SrRegistry, MissingDefaultWeightsSayWhereTheyWereLookedFor) {
   TempDir dir;
-  WeightsDirOverride weights(dir.path());
+  ScopedEnv weights("IESRGS_WEIGHTS_DIR", dir.path().string());
   const std::string message = error_message([] { make_sr_net("imdn", {}, 4); });
   EXPECT_TRUE(contains(message, (dir / "sr" / "IMDN_x4.pth").string())) << message;
   EXPECT_TRUE(contains(message, "IESRGS_WEIGHTS_DIR")) << message;
