@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/file_digest.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "pipeline/stage_record.hpp"
@@ -22,23 +23,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Identity of a file without reading it: absolute path, size and modification time.
-std::string file_identity(const fs::path& path) {
-  if (path.empty() || !fs::exists(path)) return "-";
-  const auto stamp = fs::last_write_time(path).time_since_epoch().count();
-  return fmt::format("{}:{}:{}", fs::absolute(path).string(), fs::file_size(path), stamp);
-}
-
 // Everything one view's outputs depend on besides the view itself.
 std::string stage_identity(const ExternalOptions& o, const fs::path& sr_weights) {
   return fmt::format("sr={} x{} tile={}/{} weights={} | depth={} weights={}", o.sr_model, o.scale,
-                     o.tiles.tile, o.tiles.overlap, file_identity(sr_weights), o.depth_model,
-                     file_identity(o.depth_weights));
+                     o.tiles.tile, o.tiles.overlap, file_digest(sr_weights), o.depth_model,
+                     file_digest(o.depth_weights));
 }
 
 std::string view_fingerprint(const std::string& stage, const Scene& scene, const Camera& camera) {
   const std::string text =
-      fmt::format("{} | {} {}x{} /{} bg {},{},{}", stage, file_identity(camera.image_path),
+      fmt::format("{} | {} {}x{} /{} bg {},{},{}", stage, file_digest(camera.image_path),
                   camera.intrinsics.width, camera.intrinsics.height, scene.downscale,
                   scene.background[0], scene.background[1], scene.background[2]);
   return fmt::format("{:016x}", std::hash<std::string>{}(text));

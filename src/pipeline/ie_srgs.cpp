@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "eval/mask_agreement.hpp"
 #include "io/atomic_file.hpp"
+#include "io/file_digest.hpp"
 #include "io/image_tensor.hpp"
 #include "io/view_images.hpp"
 #include "loss/texture_fusion.hpp"
@@ -145,6 +146,8 @@ class Pipeline {
   std::optional<Scene> hr_scene_;
   std::unique_ptr<ViewImages> lr_images_, hr_images_;
   double threshold_;
+  // What the rows learn from and are scored against, by content (split_images_digest).
+  std::string train_images_digest_, test_images_digest_;
   std::vector<ExternalView> external_, bicubic_;
   std::optional<InternalStage> internal_;
   nlohmann::json stages_ = nlohmann::json::object();
@@ -167,6 +170,8 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
                                      : loss::kDiscrepancyThresholdReal;
   if (o_.input_is_lr && any_row(Source::HighRes))
     fail("the hr row needs HR images, which a low-resolution input (--input-is-lr) lacks");
+  train_images_digest_ = split_images_digest(lr_scene_, Split::Train);
+  test_images_digest_ = split_images_digest(lr_scene_, Split::Test);
 }
 
 bool Pipeline::any_row(Source source) const {
@@ -300,12 +305,18 @@ nlohmann::json Pipeline::row_params(const RowSpec& row, const loss::FusionWeight
                            {"internal_depth", weights.internal_depth},
                            {"external_depth", weights.external_depth},
                            {"threshold", threshold_},
-                           {"init", o_.init}};
+                           {"init", o_.init},
+                           {"train_images", train_images_digest_},
+                           {"test_images", test_images_digest_}};
   if (row.source == Source::SuperResolved)
     params["external"] = {{"sr_model", o_.external.sr_model},
                           {"sr_weights", o_.external.sr_weights.string()},
                           {"depth_model", o_.external.depth_model},
                           {"depth_weights", o_.external.depth_weights.string()}};
+  // The stage's record holds a content fingerprint per view: it changes with any reference.
+  if (row.source == Source::SuperResolved || row.source == Source::Bicubic)
+    params["references"] = file_digest(
+        o_.output / (row.source == Source::Bicubic ? "bicubic" : "external") / "external.json");
   // The internal model's recorded training time tells which model the row's references came from.
   if (row_uses_internal(row))
     params["internal_model_seconds"] = stage_seconds(o_.output / "internal");

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "pipeline/render_views.hpp"
+#include "pipeline/stage_record.hpp"
 #include "train/session.hpp"
 
 namespace iesrgs::pipeline {
@@ -12,7 +13,9 @@ namespace iesrgs::pipeline {
 namespace {
 
 nlohmann::json internal_params(const Scene& lr_scene) {
-  return {{"scene", lr_scene.root.string()}, {"downscale", lr_scene.downscale}};
+  return {{"scene", lr_scene.root.string()},
+          {"downscale", lr_scene.downscale},
+          {"images", split_images_digest(lr_scene, Split::Train)}};
 }
 
 // A finished training's recorded time tells which model the renders came from.

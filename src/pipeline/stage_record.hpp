@@ -3,11 +3,18 @@
 // run's results.json.
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
+
+#include "io/scene.hpp"
 
 namespace iesrgs::pipeline {
 
 // The record's JSON object; an empty object when the file is missing or damaged, which only costs
 // recomputing the stage.
 nlohmann::json read_stage_record(const std::filesystem::path& path);
+
+// One content digest (file_digest) of the stored images of a split, for the records of the
+// stages that learn from or are scored against them.
+std::string split_images_digest(const Scene& scene, Split split);
 
 }  // namespace iesrgs::pipeline

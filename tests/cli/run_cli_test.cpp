@@ -172,5 +172,29 @@ TEST(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
   EXPECT_EQ(internal_psnr(), alone);
 }
 
+// Caches follow the images' content: rewriting the same bytes (a copied dataset) reuses every
+// stage, an edited training image recomputes its E_image, the internal model and the rows.
+TEST(RunCli, EditedTrainingImageRecomputesWhatLearntFromIt) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 1 --seed 3").status, 0);
+  const std::string command = "run " + scene + " -o " + out + " --rows ie-srgs,hr" + kTinySchedule;
+  ASSERT_EQ(iesrgs(command).status, 0);
+  const auto image = dir / "scene/train/r_1.png";
+  write_file_atomically(image, read_file(image));
+  const CliRun copied = iesrgs(command);
+  ASSERT_EQ(copied.status, 0) << copied.output;
+  EXPECT_TRUE(contains(copied.output, "0 views computed, 4 reused")) << copied.output;
+  EXPECT_FALSE(contains(copied.output, "it/s |")) << copied.output;
+
+  Image8 edited = read_image8(image);
+  for (uint8_t& value : edited.data) value = uint8_t(255 - value);
+  write_png(image, edited);
+  const CliRun changed = iesrgs(command);
+  ASSERT_EQ(changed.status, 0) << changed.output;
+  EXPECT_TRUE(contains(changed.output, "1 views computed, 3 reused")) << changed.output;
+  EXPECT_FALSE(contains(changed.output, "reusing the finished model")) << changed.output;
+}
+
 }  // namespace
 }  // namespace iesrgs

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "support/temp_dir.hpp"
 #include "synth/dataset_writer.hpp"
@@ -32,9 +33,23 @@ TEST(ExternalStage, SuperResolvesEveryTrainingViewOnceAndRecomputesOnChange) {
   EXPECT_EQ(header.width, 32);
   EXPECT_TRUE(views[0].depth.empty());  // no depth model
   const auto written = std::filesystem::last_write_time(views[0].image);
+  const auto written_second = std::filesystem::last_write_time(views[1].image);
 
   run_external_stage(scene, images, options, dir / "ext");  // cached: nothing rewritten
   EXPECT_EQ(std::filesystem::last_write_time(views[0].image), written);
+
+  // The same bytes written again (a copied dataset) keep the cache; an edited image does not.
+  const Camera& first = *scene.split(Split::Train)[0];
+  write_file_atomically(first.image_path, read_file(first.image_path));
+  run_external_stage(scene, images, options, dir / "ext");
+  EXPECT_EQ(std::filesystem::last_write_time(views[0].image), written);
+  Image8 edited = read_image8(first.image_path);
+  edited.data[0] ^= 0xff;
+  write_png(first.image_path, edited);
+  ViewImages reread(scene);
+  run_external_stage(scene, reread, options, dir / "ext");
+  EXPECT_NE(std::filesystem::last_write_time(views[0].image), written);
+  EXPECT_EQ(std::filesystem::last_write_time(views[1].image), written_second);
 
   options.scale = 4;  // a different stage: every view again
   run_external_stage(scene, images, options, dir / "ext");

@@ -1,0 +1,63 @@
+#include "io/file_digest.hpp"
+
+#include <fmt/core.h>
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <vector>
+
+#include "core/error.hpp"
+
+namespace iesrgs {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr uint64_t kFnvOffset = 14695981039346656037ull;
+constexpr uint64_t kFnvPrime = 1099511628211ull;
+
+uint64_t mix(uint64_t hash, uint64_t word) {
+  return (hash ^ word) * kFnvPrime;
+}
+
+uint64_t mix_bytes(uint64_t hash, const char* bytes, size_t size) {
+  size_t i = 0;
+  for (; i + 8 <= size; i += 8) {
+    uint64_t word;
+    std::memcpy(&word, bytes + i, 8);
+    hash = mix(hash, word);
+  }
+  for (; i < size; ++i) hash = mix(hash, uint8_t(bytes[i]));
+  return hash;
+}
+
+}  // namespace
+
+std::string file_digest(const fs::path& path) {
+  std::error_code ec;
+  if (path.empty() || !fs::is_regular_file(path, ec)) return "-";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail_file(path, "cannot be opened for reading");
+  uint64_t hash = mix(kFnvOffset, fs::file_size(path, ec));
+  // Whole words per chunk, so that the result does not depend on where chunks end.
+  std::vector<char> chunk(size_t(1) << 20);
+  while (in) {
+    in.read(chunk.data(), std::streamsize(chunk.size()));
+    hash = mix_bytes(hash, chunk.data(), size_t(in.gcount()));
+  }
+  if (in.bad()) fail_file(path, "read error");
+  return fmt::format("{:016x}", hash);
+}
+
+std::string files_digest(const std::vector<fs::path>& paths) {
+  uint64_t hash = kFnvOffset;
+  for (const fs::path& path : paths) {
+    const std::string entry = path.filename().string() + ":" + file_digest(path) + ";";
+    hash = mix_bytes(hash, entry.data(), entry.size());
+  }
+  return fmt::format("{:016x}", hash);
+}
+
+}  // namespace iesrgs

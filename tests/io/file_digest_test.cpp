@@ -1,0 +1,57 @@
+#include "io/file_digest.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+
+#include "support/temp_dir.hpp"
+
+namespace iesrgs {
+namespace {
+
+using testing::TempDir;
+using testing::write_text;
+
+TEST(FileDigest, FollowsTheBytesNotThePathOrTheTime) {
+  TempDir dir;
+  // Longer than one word and not a whole number of them, so both loops run.
+  const std::string bytes = "a file of thirty-one bytes here";
+  write_text(dir / "a.bin", bytes);
+  write_text(dir / "sub/b.bin", bytes);
+  std::filesystem::last_write_time(dir / "sub/b.bin", std::filesystem::file_time_type::clock::now() +
+                                                          std::chrono::hours(1));
+  EXPECT_EQ(file_digest(dir / "a.bin"), file_digest(dir / "sub/b.bin"));
+  EXPECT_EQ(file_digest(dir / "a.bin").size(), 16u);
+
+  std::string edited = bytes;
+  edited.back() = 'X';  // a tail byte
+  write_text(dir / "tail.bin", edited);
+  edited = bytes;
+  edited[3] = 'X';  // a byte of the first word
+  write_text(dir / "word.bin", edited);
+  write_text(dir / "longer.bin", bytes + '\0');
+  for (const char* other : {"tail.bin", "word.bin", "longer.bin"})
+    EXPECT_NE(file_digest(dir / "a.bin"), file_digest(dir / other)) << other;
+}
+
+TEST(FileDigest, MissingFileHasAPlaceholder) {
+  TempDir dir;
+  EXPECT_EQ(file_digest(dir / "absent"), "-");
+  EXPECT_EQ(file_digest({}), "-");
+}
+
+TEST(FileDigest, SetOfFilesFollowsNamesContentsAndOrder) {
+  TempDir dir;
+  write_text(dir / "x.png", "first");
+  write_text(dir / "y.png", "second");
+  const std::string both = files_digest({dir / "x.png", dir / "y.png"});
+  EXPECT_EQ(both, files_digest({dir / "x.png", dir / "y.png"}));
+  EXPECT_NE(both, files_digest({dir / "y.png", dir / "x.png"}));
+  EXPECT_NE(both, files_digest({dir / "x.png"}));
+  write_text(dir / "y.png", "changed");
+  EXPECT_NE(both, files_digest({dir / "x.png", dir / "y.png"}));
+}
+
+}  // namespace
+}  // namespace iesrgs
