@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Formats every tracked C++/CUDA source with the repository's .clang-format.
+# Formats every C++/CUDA source git tracks or would track (new files too) with the repository's
+# .clang-format.
 #   scripts/format.sh           rewrite the files in place
 #   scripts/format.sh --check   change nothing; fail and name the files that need formatting
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v clang-format >/dev/null || scripts/apt-install.sh clang-format
-mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.cu' '*.cuh')
+mapfile -t files < <(git ls-files --cached --others --exclude-standard '*.cpp' '*.hpp' '*.cu' '*.cuh')
 if [ "${1:-}" = "--check" ]; then
   clang-format --dry-run --Werror "${files[@]}"
 else

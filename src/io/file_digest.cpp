@@ -51,13 +51,9 @@ std::string file_digest(const fs::path& path) {
   return fmt::format("{:016x}", hash);
 }
 
-std::string files_digest(const std::vector<fs::path>& paths) {
-  uint64_t hash = kFnvOffset;
-  for (const fs::path& path : paths) {
-    const std::string entry = path.filename().string() + ":" + file_digest(path) + ";";
-    hash = mix_bytes(hash, entry.data(), entry.size());
-  }
-  return fmt::format("{:016x}", hash);
+std::string bytes_digest(std::string_view bytes) {
+  return fmt::format("{:016x}",
+                     mix_bytes(mix(kFnvOffset, bytes.size()), bytes.data(), bytes.size()));
 }
 
 }  // namespace iesrgs

@@ -4,7 +4,7 @@
 // image edited in place invalidates them.
 #include <filesystem>
 #include <string>
-#include <vector>
+#include <string_view>
 
 namespace iesrgs {
 
@@ -12,7 +12,7 @@ namespace iesrgs {
 // size; "-" when the path is empty or names no file. Throws an Error naming an unreadable file.
 std::string file_digest(const std::filesystem::path& path);
 
-// One digest of several files' names and contents, in the given order.
-std::string files_digest(const std::vector<std::filesystem::path>& paths);
+// The same digest of bytes in memory (a cache key's text).
+std::string bytes_digest(std::string_view bytes);
 
 }  // namespace iesrgs

@@ -146,8 +146,8 @@ class Pipeline {
   std::optional<Scene> hr_scene_;
   std::unique_ptr<ViewImages> lr_images_, hr_images_;
   double threshold_;
-  // What the rows learn from and are scored against, by content (split_images_digest).
-  std::string train_images_digest_, test_images_digest_;
+  // What the rows learn from and are scored against (split_digest).
+  std::string train_digest_, test_digest_;
   std::vector<ExternalView> external_, bicubic_;
   std::optional<InternalStage> internal_;
   nlohmann::json stages_ = nlohmann::json::object();
@@ -170,8 +170,8 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
                                      : loss::kDiscrepancyThresholdReal;
   if (o_.input_is_lr && any_row(Source::HighRes))
     fail("the hr row needs HR images, which a low-resolution input (--input-is-lr) lacks");
-  train_images_digest_ = split_images_digest(lr_scene_, Split::Train);
-  test_images_digest_ = split_images_digest(lr_scene_, Split::Test);
+  train_digest_ = split_digest(lr_scene_, Split::Train);
+  test_digest_ = split_digest(lr_scene_, Split::Test);
 }
 
 bool Pipeline::any_row(Source source) const {
@@ -306,8 +306,8 @@ nlohmann::json Pipeline::row_params(const RowSpec& row, const loss::FusionWeight
                            {"external_depth", weights.external_depth},
                            {"threshold", threshold_},
                            {"init", o_.init},
-                           {"train_images", train_images_digest_},
-                           {"test_images", test_images_digest_}};
+                           {"train_views", train_digest_},
+                           {"test_views", test_digest_}};
   if (row.source == Source::SuperResolved)
     params["external"] = {{"sr_model", o_.external.sr_model},
                           {"sr_weights", o_.external.sr_weights.string()},

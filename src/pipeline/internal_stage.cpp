@@ -15,7 +15,7 @@ namespace {
 nlohmann::json internal_params(const Scene& lr_scene) {
   return {{"scene", lr_scene.root.string()},
           {"downscale", lr_scene.downscale},
-          {"images", split_images_digest(lr_scene, Split::Train)}};
+          {"cameras", split_digest(lr_scene, Split::Train)}};
 }
 
 // A finished training's recorded time tells which model the renders came from.

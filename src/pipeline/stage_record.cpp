@@ -1,5 +1,8 @@
 #include "pipeline/stage_record.hpp"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
 
@@ -11,10 +14,17 @@ nlohmann::json read_stage_record(const std::filesystem::path& path) {
   return record.is_object() ? record : nlohmann::json::object();
 }
 
-std::string split_images_digest(const Scene& scene, Split split) {
-  std::vector<std::filesystem::path> paths;
-  for (const Camera* camera : scene.split(split)) paths.push_back(camera->image_path);
-  return files_digest(paths);
+std::string split_digest(const Scene& scene, Split split) {
+  std::string key;
+  for (const Camera* camera : scene.split(split)) {
+    const Intrinsics& k = camera->intrinsics;
+    const Distortion& d = camera->distortion;
+    key += fmt::format("{} {} {}x{} {} {} {} {} | {} {} {} {} | {} | {} {} {};\n", camera->name,
+                       file_digest(camera->image_path), k.width, k.height, k.fx, k.fy, k.cx, k.cy,
+                       d.k1, d.k2, d.p1, d.p2, fmt::join(camera->rotation.m, " "),
+                       camera->translation.x, camera->translation.y, camera->translation.z);
+  }
+  return bytes_digest(key);
 }
 
 }  // namespace iesrgs::pipeline

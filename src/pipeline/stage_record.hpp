@@ -13,8 +13,8 @@ namespace iesrgs::pipeline {
 // recomputing the stage.
 nlohmann::json read_stage_record(const std::filesystem::path& path);
 
-// One content digest (file_digest) of the stored images of a split, for the records of the
-// stages that learn from or are scored against them.
-std::string split_images_digest(const Scene& scene, Split split);
+// One digest of a split's cameras (name, pinhole, distortion, pose) and of the content of their
+// stored images, for the records of the stages that learn from or are scored against them.
+std::string split_digest(const Scene& scene, Split split);
 
 }  // namespace iesrgs::pipeline
