@@ -14,11 +14,7 @@ using testing::TempDir;
 
 TEST(StageRecord, SplitDigestFollowsCamerasAndImageContent) {
   TempDir dir;
-  synth::SynthOptions synth;
-  synth.size = 16;
-  synth.train_views = 2;
-  synth.test_views = 1;
-  synth::write_synth_dataset(dir / "scene", synth);
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 16, 2, 1});
   Scene scene = load_scene(dir / "scene", {});
   const std::string digest = split_digest(scene, Split::Train);
   EXPECT_NE(digest, split_digest(scene, Split::Test));
