@@ -146,7 +146,8 @@ class Pipeline {
   std::optional<Scene> hr_scene_;
   std::unique_ptr<ViewImages> lr_images_, hr_images_;
   double threshold_;
-  // What the rows learn from and are scored against (split_digest).
+  // What the internal model and the rows learn from and are scored against (split_digest),
+  // computed once: every stage's record and every cached row's check needs it.
   std::string train_digest_, test_digest_;
   std::vector<ExternalView> external_, bicubic_;
   std::optional<InternalStage> internal_;
@@ -220,8 +221,8 @@ void Pipeline::run_external_stages() {
 }
 
 void Pipeline::run_internal_stage() {
-  internal_ = pipeline::run_internal_stage(lr_scene_, *lr_images_, o_.internal_config, o_.scale,
-                                           o_.output / "internal");
+  internal_ = pipeline::run_internal_stage(lr_scene_, train_digest_, *lr_images_,
+                                           o_.internal_config, o_.scale, o_.output / "internal");
   stages_["internal_training_seconds"] = internal_->training.seconds;
   stages_["sr_splatting_seconds"] = stage_seconds(internal_->sr_dir);
 }
@@ -450,7 +451,8 @@ RunResult Pipeline::run() {
 
 bool Pipeline::row_current(const RowSpec& row) const {
   if (row_uses_internal(row) &&
-      !internal_stage_current(lr_scene_, o_.internal_config, o_.scale, o_.output / "internal"))
+      !internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
+                              o_.output / "internal"))
     return false;
   return row.source == Source::Internal ||
          training_stage_current(o_.output / "rows" / row.id, row_params(row, row_weights(row)),

@@ -5,17 +5,16 @@
 #include <chrono>
 
 #include "pipeline/render_views.hpp"
-#include "pipeline/stage_record.hpp"
 #include "train/session.hpp"
 
 namespace iesrgs::pipeline {
 
 namespace {
 
-nlohmann::json internal_params(const Scene& lr_scene) {
+nlohmann::json internal_params(const Scene& lr_scene, const std::string& train_digest) {
   return {{"scene", lr_scene.root.string()},
           {"downscale", lr_scene.downscale},
-          {"cameras", split_digest(lr_scene, Split::Train)}};
+          {"cameras", train_digest}};
 }
 
 // A finished training's recorded time tells which model the renders came from.
@@ -25,8 +24,8 @@ nlohmann::json sr_params(double model_seconds, int scale) {
 
 }  // namespace
 
-InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
-                                 const train::TrainConfig& config, int scale,
+InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train_digest,
+                                 ViewImages& lr_images, const train::TrainConfig& config, int scale,
                                  const std::filesystem::path& dir) {
   train::TrainerSetup setup =
       train::scene_setup(lr_scene, lr_images, size_t(config.test_views), dir);
@@ -39,7 +38,8 @@ InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
   for (const train::TrainView& view : setup.train_views) cameras.push_back(view.camera);
 
   InternalStage stage{
-      run_training_stage("internal model", internal_params(lr_scene), config, std::move(setup),
+      run_training_stage("internal model", internal_params(lr_scene, train_digest), config,
+                         std::move(setup),
                          [&] { return train::initial_model(lr_scene, config, {}); }),
       dir / "sr"};
   const nlohmann::json sr = sr_params(stage.training.seconds, scale);
@@ -53,9 +53,10 @@ InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
   return stage;
 }
 
-bool internal_stage_current(const Scene& lr_scene, const train::TrainConfig& config, int scale,
+bool internal_stage_current(const Scene& lr_scene, const std::string& train_digest,
+                            const train::TrainConfig& config, int scale,
                             const std::filesystem::path& dir) {
-  return training_stage_current(dir, internal_params(lr_scene), config) &&
+  return training_stage_current(dir, internal_params(lr_scene, train_digest), config) &&
          stage_finished(dir / "sr", sr_params(stage_seconds(dir), scale));
 }
 

@@ -3,6 +3,7 @@
 // views with multi-view regulation, then SR-splatting: every training view rendered from it at s
 // times the resolution with the same field of view (I_image, I_depth).
 #include <filesystem>
+#include <string>
 
 #include "io/scene.hpp"
 #include "io/view_images.hpp"
@@ -19,14 +20,16 @@ struct InternalStage {
 
 // Trains in <dir> (cached and resumable, see training_stage.hpp) on lr_scene's training views,
 // reporting PSNR on a few of its test views, then renders the SR-splatting outputs into <dir>/sr
-// unless an earlier run left them for the same model and scale.
-InternalStage run_internal_stage(const Scene& lr_scene, ViewImages& lr_images,
-                                 const train::TrainConfig& config, int scale,
+// unless an earlier run left them for the same model and scale. `train_digest` is
+// split_digest(lr_scene, Split::Train), which the caller computes once for every stage.
+InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train_digest,
+                                 ViewImages& lr_images, const train::TrainConfig& config, int scale,
                                  const std::filesystem::path& dir);
 
 // Whether <dir> holds a finished internal model for these settings and its SR-splatting renders
 // at `scale`, so that run_internal_stage would only load them.
-bool internal_stage_current(const Scene& lr_scene, const train::TrainConfig& config, int scale,
+bool internal_stage_current(const Scene& lr_scene, const std::string& train_digest,
+                            const train::TrainConfig& config, int scale,
                             const std::filesystem::path& dir);
 
 }  // namespace iesrgs::pipeline
