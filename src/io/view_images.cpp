@@ -3,9 +3,9 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdlib>
-#include <functional>
 
 #include "core/error.hpp"
+#include "io/file_digest.hpp"
 #include "io/resize.hpp"
 #include "io/undistort.hpp"
 
@@ -39,7 +39,7 @@ std::string undistort_key(const fs::path& source, const Intrinsics& k, const Dis
       fmt::format("{}|{}|{}|{}x{}|{:.9g},{:.9g},{:.9g},{:.9g}|{:.9g},{:.9g},{:.9g},{:.9g}",
                   fs::absolute(source).string(), size, mtime, k.width, k.height, k.fx, k.fy, k.cx,
                   k.cy, d.k1, d.k2, d.p1, d.p2);
-  return fmt::format("{:016x}", std::hash<std::string>{}(identity));
+  return bytes_digest(identity);
 }
 
 }  // namespace

@@ -35,7 +35,7 @@ std::string view_fingerprint(const std::string& stage, const Scene& scene, const
       fmt::format("{} | {} {}x{} /{} bg {},{},{}", stage, file_digest(camera.image_path),
                   camera.intrinsics.width, camera.intrinsics.height, scene.downscale,
                   scene.background[0], scene.background[1], scene.background[2]);
-  return fmt::format("{:016x}", std::hash<std::string>{}(text));
+  return bytes_digest(text);
 }
 
 fs::path resolved_sr_weights(const ExternalOptions& options) {
