@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -54,6 +55,19 @@ std::string file_digest(const fs::path& path) {
 std::string bytes_digest(std::string_view bytes) {
   return fmt::format("{:016x}",
                      mix_bytes(mix(kFnvOffset, bytes.size()), bytes.data(), bytes.size()));
+}
+
+std::string directory_digest(const fs::path& dir) {
+  std::error_code ec;
+  if (dir.empty() || !fs::is_directory(dir, ec)) return "-";
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir))
+    if (entry.is_regular_file()) files.push_back(entry.path());
+  std::sort(files.begin(), files.end());  // listing order is the file system's
+  std::string key;
+  for (const fs::path& file : files)
+    key += file.filename().string() + " " + file_digest(file) + "\n";
+  return bytes_digest(key);
 }
 
 }  // namespace iesrgs

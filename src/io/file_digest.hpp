@@ -15,4 +15,8 @@ std::string file_digest(const std::filesystem::path& path);
 // The same digest of bytes in memory (a cache key's text).
 std::string bytes_digest(std::string_view bytes);
 
+// One digest of the regular files directly in `dir`, by name and content (a model package's
+// files); "-" when the folder is absent.
+std::string directory_digest(const std::filesystem::path& dir);
+
 }  // namespace iesrgs

@@ -30,16 +30,12 @@ fs::path downscaled_copy(const fs::path& image_path, int downscale) {
   return fs::is_regular_file(candidate, ec) ? candidate : fs::path{};
 }
 
-// Identifies an undistorted result: the source file's identity and every parameter used.
-std::string undistort_key(const fs::path& source, const Intrinsics& k, const Distortion& d) {
-  std::error_code ec;
-  const auto size = fs::file_size(source, ec);
-  const auto mtime = fs::last_write_time(source, ec).time_since_epoch().count();
-  const std::string identity =
-      fmt::format("{}|{}|{}|{}x{}|{:.9g},{:.9g},{:.9g},{:.9g}|{:.9g},{:.9g},{:.9g},{:.9g}",
-                  fs::absolute(source).string(), size, mtime, k.width, k.height, k.fx, k.fy, k.cx,
-                  k.cy, d.k1, d.k2, d.p1, d.p2);
-  return bytes_digest(identity);
+// Identifies an undistorted result: the source's content and every parameter used.
+std::string undistort_key(const std::string& source_digest, const Intrinsics& k,
+                          const Distortion& d) {
+  return bytes_digest(
+      fmt::format("{}|{}x{}|{:.9g},{:.9g},{:.9g},{:.9g}|{:.9g},{:.9g},{:.9g},{:.9g}", source_digest,
+                  k.width, k.height, k.fx, k.fy, k.cx, k.cy, d.k1, d.k2, d.p1, d.p2));
 }
 
 }  // namespace
@@ -56,7 +52,7 @@ ViewImages::ViewImages(const Scene& scene, ViewImageOptions options)
     : scene_(scene), options_(std::move(options)) {}
 
 Image8 ViewImages::read_source(const Camera& camera, Intrinsics& source_intrinsics) const {
-  if (const fs::path copy = downscaled_copy(camera.image_path, scene_.downscale); !copy.empty()) {
+  if (const fs::path copy = source_path(camera); copy != camera.image_path) {
     Image8 image = read_image8(copy);
     const Intrinsics expected = camera.stored.scaled(1.0 / scene_.downscale);
     if (std::abs(image.width - expected.width) > 1 || std::abs(image.height - expected.height) > 1)
@@ -81,7 +77,7 @@ Image8 ViewImages::undistorted(const Camera& camera, const Image8& source,
                                const Intrinsics& source_intrinsics) const {
   const fs::path cached =
       options_.undistort_cache_dir /
-      (undistort_key(camera.image_path, source_intrinsics, camera.distortion) + ".png");
+      (undistort_key(source_digest(camera), source_intrinsics, camera.distortion) + ".png");
   std::error_code ec;
   if (fs::is_regular_file(cached, ec)) {
     try {
@@ -100,6 +96,22 @@ Image8 ViewImages::undistorted(const Camera& camera, const Image8& source,
     spdlog::warn("cannot cache the undistorted image ({}); continuing without the cache", e.what());
   }
   return image;
+}
+
+fs::path ViewImages::source_path(const Camera& camera) const {
+  const fs::path copy = downscaled_copy(camera.image_path, scene_.downscale);
+  return copy.empty() ? camera.image_path : copy;
+}
+
+std::string ViewImages::source_digest(const Camera& camera) const {
+  const fs::path path = source_path(camera);
+  {
+    std::lock_guard<std::mutex> lock(digest_mutex_);
+    if (auto it = digests_.find(path.string()); it != digests_.end()) return it->second;
+  }
+  std::string digest = file_digest(path);
+  std::lock_guard<std::mutex> lock(digest_mutex_);
+  return digests_.emplace(path.string(), std::move(digest)).first->second;
 }
 
 Image8 ViewImages::read8(const Camera& camera) const {

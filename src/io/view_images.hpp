@@ -34,7 +34,13 @@ class ViewImages {
   // The 8-bit image as it reaches the model, before compositing (RGB or RGBA).
   Image8 read8(const Camera& camera) const;
 
+  // file_digest of the file the camera's image is read from: the pre-downscaled copy when there
+  // is one, else the stored image. Taken once per file in this object's lifetime (one run), so
+  // that every cache key of a run hashes each image once.
+  std::string source_digest(const Camera& camera) const;
+
  private:
+  std::filesystem::path source_path(const Camera& camera) const;
   Image8 read_source(const Camera& camera, Intrinsics& source_intrinsics) const;
   Image8 undistorted(const Camera& camera, const Image8& source,
                      const Intrinsics& source_intrinsics) const;
@@ -47,6 +53,8 @@ class ViewImages {
                      std::pair<std::shared_ptr<const Image>, std::list<std::string>::iterator>>
       cache_;
   size_t cached_bytes_ = 0;
+  mutable std::mutex digest_mutex_;
+  mutable std::unordered_map<std::string, std::string> digests_;  // by source path
 };
 
 }  // namespace iesrgs

@@ -14,6 +14,7 @@
 #include "pipeline/stage_record.hpp"
 #include "priors/depth/depth_files.hpp"
 #include "priors/depth/depth_net.hpp"
+#include "priors/sr/esrgan.hpp"
 #include "priors/sr/registry.hpp"
 #include "priors/sr/sr_net.hpp"
 
@@ -23,16 +24,27 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The SR network's weights: its checkpoint, or an ESRGAN package's model folder for this scale.
+std::string sr_weights_digest(const ExternalOptions& o, const fs::path& sr_weights) {
+  const std::string esrgan = "esrgan-";
+  if (o.sr_model.rfind(esrgan, 0) != 0) return file_digest(sr_weights);
+  const fs::path package =
+      sr_weights.empty() ? priors::sr::default_esrgan_package_dir(o.sr_model.substr(esrgan.size()))
+                         : sr_weights;
+  return directory_digest(package / "models" / fmt::format("x{}", o.scale));
+}
+
 // Everything one view's outputs depend on besides the view itself.
 std::string stage_identity(const ExternalOptions& o, const fs::path& sr_weights) {
   return fmt::format("sr={} x{} tile={}/{} weights={} | depth={} weights={}", o.sr_model, o.scale,
-                     o.tiles.tile, o.tiles.overlap, file_digest(sr_weights), o.depth_model,
+                     o.tiles.tile, o.tiles.overlap, sr_weights_digest(o, sr_weights), o.depth_model,
                      file_digest(o.depth_weights));
 }
 
-std::string view_fingerprint(const std::string& stage, const Scene& scene, const Camera& camera) {
+std::string view_fingerprint(const std::string& stage, const Scene& scene, const ViewImages& images,
+                             const Camera& camera) {
   const std::string text =
-      fmt::format("{} | {} {}x{} /{} bg {},{},{}", stage, file_digest(camera.image_path),
+      fmt::format("{} | {} {}x{} /{} bg {},{},{}", stage, images.source_digest(camera),
                   camera.intrinsics.width, camera.intrinsics.height, scene.downscale,
                   scene.background[0], scene.background[1], scene.background[2]);
   return bytes_digest(text);
@@ -74,7 +86,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
         camera.name, dir / "image" / (camera.name + ".png"),
         options.depth_model == "none" ? fs::path() : dir / "depth" / (camera.name + ".npy")};
     views.push_back(view);
-    const std::string fingerprint = view_fingerprint(stage, scene, camera);
+    const std::string fingerprint = view_fingerprint(stage, scene, images, camera);
     const bool cached = record.value(camera.name, "") == fingerprint && fs::exists(view.image) &&
                         (view.depth.empty() || fs::exists(view.depth));
     if (cached) continue;

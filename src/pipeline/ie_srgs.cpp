@@ -171,8 +171,9 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
                                      : loss::kDiscrepancyThresholdReal;
   if (o_.input_is_lr && any_row(Source::HighRes))
     fail("the hr row needs HR images, which a low-resolution input (--input-is-lr) lacks");
-  train_digest_ = split_digest(lr_scene_, Split::Train);
-  test_digest_ = split_digest(lr_scene_, Split::Test);
+  train_digest_ = split_digest(lr_scene_, *lr_images_, Split::Train);
+  test_digest_ = hr_scene_ ? split_digest(*hr_scene_, *hr_images_, Split::Test)
+                           : split_digest(lr_scene_, *lr_images_, Split::Test);
 }
 
 bool Pipeline::any_row(Source source) const {
@@ -194,16 +195,16 @@ bool Pipeline::rows_use_internal_references() const {
 }
 
 void Pipeline::check_cached_inputs() const {
-  const auto require = [](const fs::path& record, const char* stage, const char* command) {
+  const auto require = [](const fs::path& record, const char* stage, const char* runners) {
     if (!fs::exists(record))
-      fail_file(record, fmt::format("missing: the {} stage has not run here (iesrgs {} or iesrgs "
-                                    "run with the same scene and options runs it)",
-                                    stage, command));
+      fail_file(record, fmt::format("missing: the {} stage has not run here ({} with the same "
+                                    "scene and options runs it)",
+                                    stage, runners));
   };
   if (any_row(Source::SuperResolved))
-    require(o_.output / "external" / "external.json", "external", "run");
+    require(o_.output / "external" / "external.json", "external", "iesrgs run");
   if (rows_use_internal_references())
-    require(o_.output / "internal" / "stage.json", "internal", "internal");
+    require(o_.output / "internal" / "stage.json", "internal", "iesrgs internal or iesrgs run");
 }
 
 void Pipeline::run_external_stages() {
@@ -298,7 +299,7 @@ FusionSetup Pipeline::fusion_setup(const RowSpec& row, const loss::FusionWeights
 
 nlohmann::json Pipeline::row_params(const RowSpec& row, const loss::FusionWeights& weights) const {
   nlohmann::json params = {{"row", row.id},
-                           {"scene", lr_scene_.root.string()},
+                           {"points", points_digest(lr_scene_.points)},
                            {"lr_downscale", lr_scene_.downscale},
                            {"scale", o_.scale},
                            {"texture", loss::texture_guidance_name(weights.texture)},
@@ -311,9 +312,9 @@ nlohmann::json Pipeline::row_params(const RowSpec& row, const loss::FusionWeight
                            {"test_views", test_digest_}};
   if (row.source == Source::SuperResolved)
     params["external"] = {{"sr_model", o_.external.sr_model},
-                          {"sr_weights", o_.external.sr_weights.string()},
-                          {"depth_model", o_.external.depth_model},
-                          {"depth_weights", o_.external.depth_weights.string()}};
+                          {"depth_model", o_.external.depth_model}};
+  if (row.source == Source::HighRes)
+    params["hr_train_views"] = split_digest(*hr_scene_, *hr_images_, Split::Train);
   // The stage's record holds a content fingerprint per view: it changes with any reference.
   if (row.source == Source::SuperResolved || row.source == Source::Bicubic)
     params["references"] = file_digest(

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "pipeline/render_views.hpp"
+#include "pipeline/stage_record.hpp"
 #include "train/session.hpp"
 
 namespace iesrgs::pipeline {
@@ -12,7 +13,7 @@ namespace iesrgs::pipeline {
 namespace {
 
 nlohmann::json internal_params(const Scene& lr_scene, const std::string& train_digest) {
-  return {{"scene", lr_scene.root.string()},
+  return {{"points", points_digest(lr_scene.points)},
           {"downscale", lr_scene.downscale},
           {"cameras", train_digest}};
 }

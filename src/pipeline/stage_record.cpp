@@ -14,17 +14,26 @@ nlohmann::json read_stage_record(const std::filesystem::path& path) {
   return record.is_object() ? record : nlohmann::json::object();
 }
 
-std::string split_digest(const Scene& scene, Split split) {
-  std::string key;
+std::string split_digest(const Scene& scene, const ViewImages& images, Split split) {
+  std::string key = fmt::format("background {};\n", fmt::join(scene.background, " "));
   for (const Camera* camera : scene.split(split)) {
     const Intrinsics& k = camera->intrinsics;
     const Distortion& d = camera->distortion;
     key += fmt::format("{} {} {}x{} {} {} {} {} | {} {} {} {} | {} | {} {} {};\n", camera->name,
-                       file_digest(camera->image_path), k.width, k.height, k.fx, k.fy, k.cx, k.cy,
+                       images.source_digest(*camera), k.width, k.height, k.fx, k.fy, k.cx, k.cy,
                        d.k1, d.k2, d.p1, d.p2, fmt::join(camera->rotation.m, " "),
                        camera->translation.x, camera->translation.y, camera->translation.z);
   }
   return bytes_digest(key);
+}
+
+std::string points_digest(const PointCloud& points) {
+  const auto bytes = [](const auto& values) {
+    return std::string_view(reinterpret_cast<const char*>(values.data()),
+                            values.size() * sizeof(values[0]));
+  };
+  return bytes_digest(fmt::format("{} {}", bytes_digest(bytes(points.positions)),
+                                  bytes_digest(bytes(points.colors))));
 }
 
 }  // namespace iesrgs::pipeline

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "io/scene.hpp"
+#include "io/view_images.hpp"
 
 namespace iesrgs::pipeline {
 
@@ -13,8 +14,13 @@ namespace iesrgs::pipeline {
 // recomputing the stage.
 nlohmann::json read_stage_record(const std::filesystem::path& path);
 
-// One digest of a split's cameras (name, pinhole, distortion, pose) and of the content of their
-// stored images, for the records of the stages that learn from or are scored against them.
-std::string split_digest(const Scene& scene, Split split);
+// One digest of a split's cameras (name, pinhole, distortion, pose), of the content of the image
+// files `images` reads for them and of the background they are composited over, for the records
+// of the stages that learn from or are scored against them. Not their folder: a moved or copied
+// dataset keeps its caches.
+std::string split_digest(const Scene& scene, const ViewImages& images, Split split);
+
+// Digest of the SfM points a model starts from (empty for synthetic scenes).
+std::string points_digest(const PointCloud& points);
 
 }  // namespace iesrgs::pipeline

@@ -172,28 +172,42 @@ TEST(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
   EXPECT_EQ(internal_psnr(), alone);
 }
 
-// Caches follow the images' content: rewriting the same bytes (a copied dataset) reuses every
-// stage, an edited training image recomputes its E_image, the internal model and the rows.
+// Caches follow the images' content, not their folder: rewriting the same bytes (a copied
+// dataset) or moving the dataset reuses every stage; an edited training image recomputes its
+// E_image, the internal model and the rows, and so does another background.
 TEST(RunCli, EditedTrainingImageRecomputesWhatLearntFromIt) {
   TempDir dir;
-  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
-  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 1 --seed 3").status, 0);
-  const std::string command = "run " + scene + " -o " + out + " --rows ie-srgs,hr" + kTinySchedule;
-  ASSERT_EQ(iesrgs(command).status, 0);
+  const std::string out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + (dir / "scene").string() +
+                   " --size 32 --views 4 --test-views 1 --seed 3")
+                .status,
+            0);
+  const auto command = [&](const std::string& scene, const std::string& extra = "") {
+    return "run " + (dir / scene).string() + " -o " + out + " --rows ie-srgs,hr" + kTinySchedule +
+           extra;
+  };
+  ASSERT_EQ(iesrgs(command("scene")).status, 0);
   const auto image = dir / "scene/train/r_1.png";
   write_file_atomically(image, read_file(image));
-  const CliRun copied = iesrgs(command);
+  std::filesystem::rename(dir / "scene", dir / "moved");
+  const CliRun copied = iesrgs(command("moved"));
   ASSERT_EQ(copied.status, 0) << copied.output;
   EXPECT_TRUE(contains(copied.output, "0 views computed, 4 reused")) << copied.output;
   EXPECT_FALSE(contains(copied.output, "it/s |")) << copied.output;
 
-  Image8 edited = read_image8(image);
+  const auto moved_image = dir / "moved/train/r_1.png";
+  Image8 edited = read_image8(moved_image);
   for (uint8_t& value : edited.data) value = uint8_t(255 - value);
-  write_png(image, edited);
-  const CliRun changed = iesrgs(command);
+  write_png(moved_image, edited);
+  const CliRun changed = iesrgs(command("moved"));
   ASSERT_EQ(changed.status, 0) << changed.output;
   EXPECT_TRUE(contains(changed.output, "1 views computed, 3 reused")) << changed.output;
   EXPECT_FALSE(contains(changed.output, "reusing the finished model")) << changed.output;
+
+  const CliRun black = iesrgs(command("moved", " --background black"));
+  ASSERT_EQ(black.status, 0) << black.output;
+  EXPECT_TRUE(contains(black.output, "4 views computed, 0 reused")) << black.output;
+  EXPECT_FALSE(contains(black.output, "reusing the finished model")) << black.output;
 }
 
 }  // namespace

@@ -49,5 +49,20 @@ TEST(FileDigest, BytesInMemoryDigestLikeTheFileHoldingThem) {
   EXPECT_NE(bytes_digest(bytes), bytes_digest(bytes.substr(1)));
 }
 
+TEST(FileDigest, DirectoryDigestFollowsItsFilesNamesAndContent) {
+  TempDir dir;
+  EXPECT_EQ(directory_digest(dir / "model"), "-");
+  write_text(dir / "model/model.json", "{}");
+  write_text(dir / "model/group1-shard1of1.bin", "weights");
+  write_text(dir / "copy/group1-shard1of1.bin", "weights");
+  write_text(dir / "copy/model.json", "{}");
+  const std::string digest = directory_digest(dir / "model");
+  EXPECT_EQ(directory_digest(dir / "copy"), digest);
+  write_text(dir / "copy/group1-shard1of1.bin", "weightz");
+  EXPECT_NE(directory_digest(dir / "copy"), digest);
+  write_text(dir / "model/extra.bin", "");
+  EXPECT_NE(directory_digest(dir / "model"), digest);
+}
+
 }  // namespace
 }  // namespace iesrgs

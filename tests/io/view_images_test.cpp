@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "io/atomic_file.hpp"
 #include "io/view_images.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
@@ -107,6 +108,28 @@ TEST(ViewImages, UndistortsOnceIntoTheCache) {
     cached += entry.path().extension() == ".png";
   EXPECT_EQ(cached, 1);
   EXPECT_EQ(images.read8(camera).data, first.data);
+}
+
+// The cache entry is named by the source's content: a copy with a new time reuses it, an edited
+// image (read by the next run) gets its own.
+TEST(ViewImages, UndistortionCacheFollowsTheSourceContent) {
+  SceneFixture f;
+  Camera camera = f.add("a.png", solid(16, 12, {9, 99, 199}));
+  camera.distortion = {0.05, 0, 0, 0};
+  const auto entries = [&] {
+    int count = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(f.options.undistort_cache_dir))
+      count += entry.path().extension() == ".png";
+    return count;
+  };
+  ViewImages(f.scene, f.options).read8(camera);
+  write_file_atomically(camera.image_path, read_file(camera.image_path));
+  ViewImages(f.scene, f.options).read8(camera);
+  EXPECT_EQ(entries(), 1);
+  write_png(camera.image_path, solid(16, 12, {200, 10, 10}));
+  const Image8 edited = ViewImages(f.scene, f.options).read8(camera);
+  EXPECT_EQ(entries(), 2);
+  EXPECT_EQ(edited.data[0], 200);
 }
 
 }  // namespace

@@ -12,26 +12,62 @@ namespace {
 
 using testing::TempDir;
 
-TEST(StageRecord, SplitDigestFollowsCamerasAndImageContent) {
+// Digests are taken once per ViewImages (one run), so each check reads the files afresh.
+std::string train_digest(const Scene& scene) {
+  return split_digest(scene, ViewImages(scene), Split::Train);
+}
+
+TEST(StageRecord, SplitDigestFollowsCamerasImageContentAndBackground) {
   TempDir dir;
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 16, 2, 1});
   Scene scene = load_scene(dir / "scene", {});
-  const std::string digest = split_digest(scene, Split::Train);
-  EXPECT_NE(digest, split_digest(scene, Split::Test));
+  const std::string digest = train_digest(scene);
+  EXPECT_NE(digest, split_digest(scene, ViewImages(scene), Split::Test));
 
   const auto image = scene.split(Split::Train)[1]->image_path;
   write_file_atomically(image, read_file(image));  // same bytes, new file
-  EXPECT_EQ(split_digest(scene, Split::Train), digest);
+  EXPECT_EQ(train_digest(scene), digest);
+
+  std::filesystem::rename(dir / "scene", dir / "copied");  // a moved dataset keeps its caches
+  EXPECT_EQ(train_digest(load_scene(dir / "copied", {})), digest);
+  std::filesystem::rename(dir / "copied", dir / "scene");
 
   Scene moved = scene;
   for (Camera& camera : moved.cameras)
     if (camera.split == Split::Train) camera.translation.z += 1e-9;
-  EXPECT_NE(split_digest(moved, Split::Train), digest);
+  EXPECT_NE(train_digest(moved), digest);
+
+  Scene black = scene;
+  black.background = {0, 0, 0};
+  EXPECT_NE(train_digest(black), digest);
 
   Image8 edited = read_image8(image);
   edited.data[0] ^= 1;
   write_png(image, edited);
-  EXPECT_NE(split_digest(scene, Split::Train), digest);
+  EXPECT_NE(train_digest(scene), digest);
+}
+
+TEST(StageRecord, SplitDigestReadsThePreDownscaledCopyWhenThereIsOne) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 16, 2, 1});
+  const Scene half = load_scene(dir / "scene", SceneOptions{2});
+  const std::string digest = train_digest(half);
+  const auto image = half.split(Split::Train)[0]->image_path;
+  const auto copy = image.parent_path().parent_path() /
+                    (image.parent_path().filename().string() + "_2") / image.filename();
+  std::filesystem::create_directories(copy.parent_path());
+  Image8 other = read_image8(image);  // not a half-size image: only its bytes count here
+  other.data[0] ^= 1;
+  write_png(copy, other);
+  EXPECT_NE(train_digest(half), digest);
+}
+
+TEST(StageRecord, PointsDigestFollowsPositionsAndColors) {
+  PointCloud points{{{0, 0, 0}, {1, 2, 3}}, {{{1, 2, 3}}, {{4, 5, 6}}}};
+  const std::string digest = points_digest(points);
+  EXPECT_NE(digest, points_digest({}));
+  points.colors[1][0] = 7;
+  EXPECT_NE(points_digest(points), digest);
 }
 
 }  // namespace
