@@ -24,20 +24,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The SR network's weights: its checkpoint, or an ESRGAN package's model folder for this scale.
-std::string sr_weights_digest(const ExternalOptions& o, const fs::path& sr_weights) {
+// What the SR network computes besides its name and scale: its checkpoint (the default one when
+// none is given), or an ESRGAN package's model folder for this scale.
+std::string sr_weights_digest(const ExternalOptions& o) {
   const std::string esrgan = "esrgan-";
-  if (o.sr_model.rfind(esrgan, 0) != 0) return file_digest(sr_weights);
-  const fs::path package =
-      sr_weights.empty() ? priors::sr::default_esrgan_package_dir(o.sr_model.substr(esrgan.size()))
-                         : sr_weights;
-  return directory_digest(package / "models" / fmt::format("x{}", o.scale));
+  if (o.sr_model.rfind(esrgan, 0) == 0)
+    return directory_digest(
+        priors::sr::esrgan_model_dir(o.sr_model.substr(esrgan.size()), o.scale, o.sr_weights));
+  if (!o.sr_weights.empty() || o.sr_model == "bicubic") return file_digest(o.sr_weights);
+  return file_digest(priors::sr::default_sr_weights(o.sr_model, o.scale));
 }
 
 // Everything one view's outputs depend on besides the view itself.
-std::string stage_identity(const ExternalOptions& o, const fs::path& sr_weights) {
+std::string stage_identity(const ExternalOptions& o) {
   return fmt::format("sr={} x{} tile={}/{} weights={} | depth={} weights={}", o.sr_model, o.scale,
-                     o.tiles.tile, o.tiles.overlap, sr_weights_digest(o, sr_weights), o.depth_model,
+                     o.tiles.tile, o.tiles.overlap, sr_weights_digest(o), o.depth_model,
                      file_digest(o.depth_weights));
 }
 
@@ -48,13 +49,6 @@ std::string view_fingerprint(const std::string& stage, const Scene& scene, const
                   camera.intrinsics.width, camera.intrinsics.height, scene.downscale,
                   scene.background[0], scene.background[1], scene.background[2]);
   return bytes_digest(text);
-}
-
-fs::path resolved_sr_weights(const ExternalOptions& options) {
-  if (!options.sr_weights.empty() || options.sr_model == "bicubic" ||
-      options.sr_model.rfind("esrgan", 0) == 0)
-    return options.sr_weights;
-  return priors::sr::default_sr_weights(options.sr_model, options.scale);
 }
 
 }  // namespace
@@ -68,8 +62,7 @@ void resolve_sr_model(ExternalOptions& options) {
 std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& images,
                                              const ExternalOptions& options, const fs::path& dir) {
   if (options.sr_model == "auto") fail("run_external_stage: resolve the SR model first");
-  const fs::path sr_weights = resolved_sr_weights(options);
-  const std::string stage = stage_identity(options, sr_weights);
+  const std::string stage = stage_identity(options);
   const fs::path record_path = dir / "external.json";
   nlohmann::json record = read_stage_record(record_path);
   std::unique_ptr<priors::sr::SrNet> sr;  // loaded only when some view needs it

@@ -79,14 +79,18 @@ fs::path default_esrgan_package_dir(const std::string& variant) {
   return npm_dir() / "node_modules" / "@upscalerjs" / ("esrgan-" + variant);
 }
 
+fs::path esrgan_model_dir(const std::string& variant, int scale, const fs::path& package_dir) {
+  const fs::path folder = package_dir.empty() ? default_esrgan_package_dir(variant) : package_dir;
+  return folder / "models" / fmt::format("x{}", scale);
+}
+
 std::unique_ptr<SrNet> make_esrgan(const std::string& variant, int scale,
                                    const fs::path& package_dir) {
   const Variant& found = find_variant(variant);
   const std::string name = "esrgan-" + variant;
   if (std::find(std::begin(kScales), std::end(kScales), scale) == std::end(kScales))
     fail("{}: no model for scale {} (available: 2, 3, 4, 8)", name, scale);
-  const fs::path folder = package_dir.empty() ? default_esrgan_package_dir(variant) : package_dir;
-  const fs::path model_json = folder / "models" / fmt::format("x{}", scale) / "model.json";
+  const fs::path model_json = esrgan_model_dir(variant, scale, package_dir) / "model.json";
   if (!fs::exists(model_json))
     fail_file(model_json, fmt::format("{} is not installed ({})", name,
                                       install_hint(name, package_dir.empty())));

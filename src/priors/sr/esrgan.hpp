@@ -16,6 +16,11 @@ namespace iesrgs::priors::sr {
 std::unique_ptr<SrNet> make_esrgan(const std::string& variant, int scale,
                                    const std::filesystem::path& package_dir);
 
+// The package's folder holding the model for `scale` (models/x<scale>, with model.json and its
+// weight shards); an empty `package_dir` selects default_esrgan_package_dir(variant).
+std::filesystem::path esrgan_model_dir(const std::string& variant, int scale,
+                                       const std::filesystem::path& package_dir);
+
 // <npm dir>/node_modules/@upscalerjs/esrgan-<variant>, where <npm dir> is $IESRGS_NPM_DIR or, when
 // that is unset, third_party/npm in the source tree (scripts/setup.sh installs esrgan-slim there).
 std::filesystem::path default_esrgan_package_dir(const std::string& variant);

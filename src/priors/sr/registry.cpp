@@ -149,9 +149,7 @@ std::unique_ptr<SrNet> make_sr_net(const std::string& model, const fs::path& wei
 
 std::string auto_sr_model(int scale) {
   if (fs::exists(default_sr_weights("safmn", scale))) return "safmn";
-  const fs::path esrgan =
-      default_esrgan_package_dir("slim") / "models" / fmt::format("x{}", scale) / "model.json";
-  if (fs::exists(esrgan)) return "esrgan-slim";
+  if (fs::exists(esrgan_model_dir("slim", scale, {}) / "model.json")) return "esrgan-slim";
   return "bicubic";
 }
 
