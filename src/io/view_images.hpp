@@ -39,6 +39,8 @@ class ViewImages {
   // that every cache key of a run hashes each image once.
   std::string source_digest(const Camera& camera) const;
 
+  const Scene& scene() const { return scene_; }
+
  private:
   std::filesystem::path source_path(const Camera& camera) const;
   Image8 read_source(const Camera& camera, Intrinsics& source_intrinsics) const;

@@ -42,8 +42,9 @@ std::string stage_identity(const ExternalOptions& o) {
                      file_digest(o.depth_weights));
 }
 
-std::string view_fingerprint(const std::string& stage, const Scene& scene, const ViewImages& images,
+std::string view_fingerprint(const std::string& stage, const ViewImages& images,
                              const Camera& camera) {
+  const Scene& scene = images.scene();
   const std::string text =
       fmt::format("{} | {} {}x{} /{} bg {},{},{}", stage, images.source_digest(camera),
                   camera.intrinsics.width, camera.intrinsics.height, scene.downscale,
@@ -79,7 +80,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
         camera.name, dir / "image" / (camera.name + ".png"),
         options.depth_model == "none" ? fs::path() : dir / "depth" / (camera.name + ".npy")};
     views.push_back(view);
-    const std::string fingerprint = view_fingerprint(stage, scene, images, camera);
+    const std::string fingerprint = view_fingerprint(stage, images, camera);
     const bool cached = record.value(camera.name, "") == fingerprint && fs::exists(view.image) &&
                         (view.depth.empty() || fs::exists(view.depth));
     if (cached) continue;

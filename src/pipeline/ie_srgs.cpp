@@ -171,9 +171,8 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
                                      : loss::kDiscrepancyThresholdReal;
   if (o_.input_is_lr && any_row(Source::HighRes))
     fail("the hr row needs HR images, which a low-resolution input (--input-is-lr) lacks");
-  train_digest_ = split_digest(lr_scene_, *lr_images_, Split::Train);
-  test_digest_ = hr_scene_ ? split_digest(*hr_scene_, *hr_images_, Split::Test)
-                           : split_digest(lr_scene_, *lr_images_, Split::Test);
+  train_digest_ = split_digest(*lr_images_, Split::Train);
+  test_digest_ = split_digest(hr_images_ ? *hr_images_ : *lr_images_, Split::Test);
 }
 
 bool Pipeline::any_row(Source source) const {
@@ -314,7 +313,7 @@ nlohmann::json Pipeline::row_params(const RowSpec& row, const loss::FusionWeight
     params["external"] = {{"sr_model", o_.external.sr_model},
                           {"depth_model", o_.external.depth_model}};
   if (row.source == Source::HighRes)
-    params["hr_train_views"] = split_digest(*hr_scene_, *hr_images_, Split::Train);
+    params["hr_train_views"] = split_digest(*hr_images_, Split::Train);
   // The stage's record holds a content fingerprint per view: it changes with any reference.
   if (row.source == Source::SuperResolved || row.source == Source::Bicubic)
     params["references"] = file_digest(

@@ -21,7 +21,7 @@ struct InternalStage {
 // Trains in <dir> (cached and resumable, see training_stage.hpp) on lr_scene's training views,
 // reporting PSNR on a few of its test views, then renders the SR-splatting outputs into <dir>/sr
 // unless an earlier run left them for the same model and scale. `train_digest` is
-// split_digest(lr_scene, images, Split::Train), which the caller computes once for every stage.
+// split_digest(lr_images, Split::Train), which the caller computes once for every stage.
 InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train_digest,
                                  ViewImages& lr_images, const train::TrainConfig& config, int scale,
                                  const std::filesystem::path& dir);

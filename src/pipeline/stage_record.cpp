@@ -14,7 +14,8 @@ nlohmann::json read_stage_record(const std::filesystem::path& path) {
   return record.is_object() ? record : nlohmann::json::object();
 }
 
-std::string split_digest(const Scene& scene, const ViewImages& images, Split split) {
+std::string split_digest(const ViewImages& images, Split split) {
+  const Scene& scene = images.scene();
   std::string key = fmt::format("background {};\n", fmt::join(scene.background, " "));
   for (const Camera* camera : scene.split(split)) {
     const Intrinsics& k = camera->intrinsics;

@@ -14,11 +14,11 @@ namespace iesrgs::pipeline {
 // recomputing the stage.
 nlohmann::json read_stage_record(const std::filesystem::path& path);
 
-// One digest of a split's cameras (name, pinhole, distortion, pose), of the content of the image
-// files `images` reads for them and of the background they are composited over, for the records
-// of the stages that learn from or are scored against them. Not their folder: a moved or copied
-// dataset keeps its caches.
-std::string split_digest(const Scene& scene, const ViewImages& images, Split split);
+// One digest of the cameras of a split of `images`' scene (name, pinhole, distortion, pose), of
+// the content of the image files `images` reads for them and of the background they are
+// composited over, for the records of the stages that learn from or are scored against them. Not
+// their folder: a moved or copied dataset keeps its caches.
+std::string split_digest(const ViewImages& images, Split split);
 
 // Digest of the SfM points a model starts from (empty for synthetic scenes).
 std::string points_digest(const PointCloud& points);

@@ -14,7 +14,7 @@ using testing::TempDir;
 
 // Digests are taken once per ViewImages (one run), so each check reads the files afresh.
 std::string train_digest(const Scene& scene) {
-  return split_digest(scene, ViewImages(scene), Split::Train);
+  return split_digest(ViewImages(scene), Split::Train);
 }
 
 TEST(StageRecord, SplitDigestFollowsCamerasImageContentAndBackground) {
@@ -22,7 +22,7 @@ TEST(StageRecord, SplitDigestFollowsCamerasImageContentAndBackground) {
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 16, 2, 1});
   Scene scene = load_scene(dir / "scene", {});
   const std::string digest = train_digest(scene);
-  EXPECT_NE(digest, split_digest(scene, ViewImages(scene), Split::Test));
+  EXPECT_NE(digest, split_digest(ViewImages(scene), Split::Test));
 
   const auto image = scene.split(Split::Train)[1]->image_path;
   write_file_atomically(image, read_file(image));  // same bytes, new file
