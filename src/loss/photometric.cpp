@@ -78,9 +78,16 @@ double weighted_photometric_loss(const T* x, const T* y, const ImageShape& shape
                                  const T* weight, T* grad_x) {
   check_shape(shape, "weighted_photometric_loss");
   const size_t pixels = shape.pixels();
+  // Tiles beat whole-width bands once most of them can be skipped.
+  const SsimSupport support = ssim_support(weight, shape);
+  const bool sparse = 2 * support.weighted.size() < support.tiles;
   std::vector<T> ssim_map(pixels);
   std::vector<T> partials(grad_x ? ssim_partials_size(shape) : 0);
-  ssim<T>(x, y, shape, ssim_map.data(), grad_x ? partials.data() : nullptr);
+  T* partials_out = grad_x ? partials.data() : nullptr;
+  if (sparse)
+    ssim_in<T>(x, y, shape, support.weighted, ssim_map.data(), partials_out);
+  else
+    ssim<T>(x, y, shape, ssim_map.data(), partials_out);
   double sum = 0;
 #pragma omp parallel for reduction(+ : sum)
   for (int64_t p = 0; p < int64_t(pixels); ++p) {
@@ -89,7 +96,11 @@ double weighted_photometric_loss(const T* x, const T* y, const ImageShape& shape
   }
   if (grad_x) {
     l1_backward(x, y, shape, scaled(weight, pixels, 1 - lambda).data(), grad_x);
-    ssim_backward(x, y, shape, partials.data(), scaled(weight, pixels, -lambda).data(), grad_x);
+    const std::vector<T> ssim_weight = scaled(weight, pixels, -lambda);
+    if (sparse)
+      ssim_backward_in(x, y, shape, support.reached, partials.data(), ssim_weight.data(), grad_x);
+    else
+      ssim_backward(x, y, shape, partials.data(), ssim_weight.data(), grad_x);
   }
   return sum;
 }

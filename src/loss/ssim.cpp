@@ -83,19 +83,24 @@ void sweep(int r0, int r1, RowPass&& row_pass, ColumnPass&& column_pass) {
   }
 }
 
-// One band of rows per thread: each band re-runs the row pass on the kRadius rows beyond each of
-// its ends, which costs little next to sharing rows between threads.
-int band_count(int height) {
-  return std::min(height, omp_get_max_threads());
+// One band of rows per thread, as wide as the image: each band re-runs the row pass on the
+// kRadius rows beyond each of its ends, which costs little next to sharing rows between threads.
+std::vector<PixelBox> bands(const ImageShape& shape) {
+  const int count = std::min(shape.height, omp_get_max_threads());
+  std::vector<PixelBox> boxes;
+  for (int band = 0; band < count; ++band)
+    boxes.push_back({int(int64_t(shape.height) * band / count),
+                     int(int64_t(shape.height) * (band + 1) / count), 0, shape.width});
+  return boxes;
 }
 
-// body(band, r0, r1) for the bands [r0, r1) of the rows, in parallel.
+// body(i, boxes[i]) for every box, in parallel; bands take one thread each, tiles are many and
+// uneven, so they go to whichever thread is free.
 template <typename Body>
-void for_each_band(int height, Body&& body) {
-  const int bands = band_count(height);
-#pragma omp parallel for schedule(static, 1)
-  for (int band = 0; band < bands; ++band)
-    body(band, int(int64_t(height) * band / bands), int(int64_t(height) * (band + 1) / bands));
+void for_each_box(const std::vector<PixelBox>& boxes, Body&& body) {
+  const int64_t count = int64_t(boxes.size());
+#pragma omp parallel for schedule(dynamic)
+  for (int64_t i = 0; i < count; ++i) body(i, boxes[i]);
 }
 
 // Offset of row r of channel c in a CHW array.
@@ -103,11 +108,17 @@ size_t row_offset(const ImageShape& shape, int c, int r) {
   return (size_t(c) * shape.height + r) * shape.width;
 }
 
-// Copies row r of channel c into padded[kRadius, kRadius + width); the kRadius values at either
-// end stay zero, the convolution's zero padding.
-template <typename T>
-void copy_padded(const T* image, const ImageShape& shape, int c, int r, T* padded) {
-  std::copy_n(image + row_offset(shape, c, r), shape.width, padded + kRadius);
+// Columns of row r that the row pass of `box` reads: [col0 - kRadius, col1 + kRadius) clipped to
+// the image, as an offset into the row and into the padded buffer. The padded buffer's other
+// values stay zero, the convolution's zero padding.
+struct PaddedSpan {
+  int first, count, padded_offset;
+};
+
+PaddedSpan padded_span(const ImageShape& shape, const PixelBox& box) {
+  const int first = std::max(0, box.col0 - kRadius);
+  const int last = std::min(shape.width, box.col1 + kRadius);
+  return {first, last - first, first - (box.col0 - kRadius)};
 }
 
 // Window statistics of one channel along one row: means of x and y, spread (sum of the two
@@ -176,29 +187,36 @@ SsimPoint<T> ssim_point(T mean_x, T mean_y, T spread, T cross) {
           2 * a1 * inv_b};
 }
 
+// The forward pass over the pixels of one box: map and partials there, nothing elsewhere.
 template <typename T>
-class ForwardBand {
+class ForwardBox {
  public:
-  ForwardBand(const T* x, const T* y, const ImageShape& shape, T* map, T* partials)
+  ForwardBox(const T* x, const T* y, const ImageShape& shape, const PixelBox& box, T* map,
+             T* partials)
       : x_(x),
         y_(y),
         shape_(shape),
+        box_(box),
+        width_(box.col1 - box.col0),
+        span_(padded_span(shape, box)),
         map_(map),
         partials_(partials),
-        ring_(kMomentPlanes, shape.width),
-        padded_x_(shape.width + 2 * kRadius, T(0)),
+        ring_(kMomentPlanes, width_),
+        padded_x_(width_ + 2 * kRadius, T(0)),
         padded_y_(padded_x_),
-        stats_(kMomentPlanes * shape.width),
-        points_((1 + kPartialPlanes) * shape.width) {}
+        stats_(kMomentPlanes * width_),
+        points_((1 + kPartialPlanes) * width_) {}
 
-  // Sum of the per-channel SSIM over rows [r0, r1).
-  double run(int r0, int r1) {
-    const int width = shape_.width;
-    if (map_) std::fill(map_ + size_t(r0) * width, map_ + size_t(r1) * width, T(0));
+  // Sum of the per-channel SSIM over the box.
+  double run() {
+    if (map_)
+      for (int r = box_.row0; r < box_.row1; ++r)
+        std::fill_n(map_ + size_t(r) * shape_.width + box_.col0, width_, T(0));
     double sum = 0;
     for (int c = 0; c < shape_.channels; ++c) {
       sweep(
-          r0, r1, [&](int r) { row_pass(r, c); }, [&](int r) { sum += column_pass(r, c); });
+          box_.row0, box_.row1, [&](int r) { row_pass(r, c); },
+          [&](int r) { sum += column_pass(r, c); });
     }
     return sum;
   }
@@ -213,20 +231,20 @@ class ForwardBand {
       ring_.clear(r);
       return;
     }
-    copy_padded(x_, shape_, c, r, padded_x_.data());
-    copy_padded(y_, shape_, c, r, padded_y_.data());
+    const size_t offset = row_offset(shape_, c, r) + span_.first;
+    std::copy_n(x_ + offset, span_.count, padded_x_.data() + span_.padded_offset);
+    std::copy_n(y_ + offset, span_.count, padded_y_.data() + span_.padded_offset);
     const T* xs[kSsimWindow];
     const T* ys[kSsimWindow];
     for (int k = 0; k < kSsimWindow; ++k) {
       xs[k] = padded_x_.data() + k;
       ys[k] = padded_y_.data() + k;
     }
-    combine_moments<false, T>(window<T>().tap, xs, ys, nullptr, nullptr, shape_.width,
-                              ring_rows(r));
+    combine_moments<false, T>(window<T>().tap, xs, ys, nullptr, nullptr, width_, ring_rows(r));
   }
 
   double column_pass(int r, int c) {
-    const int width = shape_.width;
+    const int width = width_;
     const T* rows[kMomentPlanes][kSsimWindow];
     for (int plane = 0; plane < kMomentPlanes; ++plane) ring_.column(r, plane, rows[plane]);
     T* s = stats_.data();
@@ -247,14 +265,14 @@ class ForwardBand {
       d_cross[x] = p.d_cross;
     }
     if (partials_) {
-      const size_t offset = row_offset(shape_, c, r);
+      const size_t offset = row_offset(shape_, c, r) + box_.col0;
       for (int plane = 0; plane < kPartialPlanes; ++plane)
         std::copy_n(d_mean + size_t(plane) * width, width,
                     partials_ + plane * shape_.values() + offset);
     }
     if (map_) {
       const T inv_channels = T(1) / shape_.channels;
-      T* map_row = map_ + size_t(r) * width;
+      T* map_row = map_ + size_t(r) * shape_.width + box_.col0;
       for (int x = 0; x < width; ++x) map_row[x] += values[x] * inv_channels;
     }
     double sum = 0;
@@ -265,6 +283,9 @@ class ForwardBand {
   const T* x_;
   const T* y_;
   ImageShape shape_;
+  PixelBox box_;
+  int width_;
+  PaddedSpan span_;
   T* map_;
   T* partials_;
   RowRing<T> ring_;
@@ -274,26 +295,29 @@ class ForwardBand {
 // The gradient of sum_p weight[p] * S_c(p) with respect to x_c(q) is the window-weighted sum over
 // the pixels p that see q of the derivatives with respect to mean (times 1), mean square (times
 // 2 x(q)) and mean product (times y(q)): three more blurs, as the window is symmetric and the
-// zero padding makes the convolution its own adjoint.
+// zero padding makes the convolution its own adjoint. One box of q at a time.
 template <typename T>
-class BackwardBand {
+class BackwardBox {
  public:
-  BackwardBand(const T* x, const T* y, const ImageShape& shape, const T* partials, const T* weight,
-               T* grad_x)
+  BackwardBox(const T* x, const T* y, const ImageShape& shape, const PixelBox& box,
+              const T* partials, const T* weight, T* grad_x)
       : x_(x),
         y_(y),
         shape_(shape),
+        box_(box),
+        width_(box.col1 - box.col0),
+        span_(padded_span(shape, box)),
         partials_(partials),
         weight_(weight),
         grad_x_(grad_x),
-        ring_(kPartialPlanes, shape.width),
-        padded_(size_t(kPartialPlanes) * (shape.width + 2 * kRadius), T(0)),
-        blurred_(size_t(kPartialPlanes) * shape.width) {}
+        ring_(kPartialPlanes, width_),
+        padded_(size_t(kPartialPlanes) * (width_ + 2 * kRadius), T(0)),
+        blurred_(size_t(kPartialPlanes) * width_) {}
 
-  void run(int r0, int r1) {
+  void run() {
     for (int c = 0; c < shape_.channels; ++c)
       sweep(
-          r0, r1, [&](int r) { row_pass(r, c); }, [&](int r) { column_pass(r, c); });
+          box_.row0, box_.row1, [&](int r) { row_pass(r, c); }, [&](int r) { column_pass(r, c); });
   }
 
  private:
@@ -302,21 +326,22 @@ class BackwardBand {
       ring_.clear(r);
       return;
     }
-    const int width = shape_.width;
     const T inv_channels = T(1) / shape_.channels;
-    const T* weight = weight_ + size_t(r) * width;
+    const T* weight = weight_ + size_t(r) * shape_.width + span_.first;
     for (int plane = 0; plane < kPartialPlanes; ++plane) {
-      T* padded = padded_.data() + size_t(plane) * (width + 2 * kRadius);
-      const T* partial = partials_ + plane * shape_.values() + row_offset(shape_, c, r);
-      for (int x = 0; x < width; ++x) padded[kRadius + x] = weight[x] * inv_channels * partial[x];
+      T* padded = padded_.data() + size_t(plane) * (width_ + 2 * kRadius);
+      const T* partial =
+          partials_ + plane * shape_.values() + row_offset(shape_, c, r) + span_.first;
+      T* in_image = padded + span_.padded_offset;
+      for (int x = 0; x < span_.count; ++x) in_image[x] = weight[x] * inv_channels * partial[x];
       const T* rows[kSsimWindow];
       for (int k = 0; k < kSsimWindow; ++k) rows[k] = padded + k;
-      blur(window<T>().tap, rows, width, ring_.row(r, plane));
+      blur(window<T>().tap, rows, width_, ring_.row(r, plane));
     }
   }
 
   void column_pass(int r, int c) {
-    const int width = shape_.width;
+    const int width = width_;
     for (int plane = 0; plane < kPartialPlanes; ++plane) {
       const T* rows[kSsimWindow];
       ring_.column(r, plane, rows);
@@ -325,7 +350,7 @@ class BackwardBand {
     const T* d_mean = blurred_.data();
     const T* d_square = d_mean + width;
     const T* d_cross = d_square + width;
-    const size_t offset = row_offset(shape_, c, r);
+    const size_t offset = row_offset(shape_, c, r) + box_.col0;
     const T* x = x_ + offset;
     const T* y = y_ + offset;
     T* grad_x = grad_x_ + offset;
@@ -336,6 +361,9 @@ class BackwardBand {
   const T* x_;
   const T* y_;
   ImageShape shape_;
+  PixelBox box_;
+  int width_;
+  PaddedSpan span_;
   const T* partials_;
   const T* weight_;
   T* grad_x_;
@@ -346,31 +374,77 @@ class BackwardBand {
 }  // namespace
 
 template <typename T>
-double ssim(const T* x, const T* y, const ImageShape& shape, T* map, T* partials) {
+SsimSupport ssim_support(const T* weight, const ImageShape& shape) {
+  check_shape(shape, "ssim_support");
+  const int tile_rows = (shape.height + kSsimTile - 1) / kSsimTile;
+  const int tile_cols = (shape.width + kSsimTile - 1) / kSsimTile;
+  std::vector<uint8_t> weighted(size_t(tile_rows) * tile_cols, 0), reached(weighted.size(), 0);
+  for (int r = 0; r < shape.height; ++r)
+    for (int col = 0; col < shape.width; ++col) {
+      if (weight[size_t(r) * shape.width + col] == 0) continue;
+      weighted[size_t(r / kSsimTile) * tile_cols + col / kSsimTile] = 1;
+      for (int tr = std::max(0, r - kRadius) / kSsimTile;
+           tr <= std::min(shape.height - 1, r + kRadius) / kSsimTile; ++tr)
+        for (int tc = std::max(0, col - kRadius) / kSsimTile;
+             tc <= std::min(shape.width - 1, col + kRadius) / kSsimTile; ++tc)
+          reached[size_t(tr) * tile_cols + tc] = 1;
+    }
+  SsimSupport support;
+  support.tiles = weighted.size();
+  for (int tr = 0; tr < tile_rows; ++tr)
+    for (int tc = 0; tc < tile_cols; ++tc) {
+      const PixelBox tile{tr * kSsimTile, std::min(shape.height, (tr + 1) * kSsimTile),
+                          tc * kSsimTile, std::min(shape.width, (tc + 1) * kSsimTile)};
+      if (weighted[size_t(tr) * tile_cols + tc]) support.weighted.push_back(tile);
+      if (reached[size_t(tr) * tile_cols + tc]) support.reached.push_back(tile);
+    }
+  return support;
+}
+
+template <typename T>
+double ssim_in(const T* x, const T* y, const ImageShape& shape, const std::vector<PixelBox>& boxes,
+               T* map, T* partials) {
   check_shape(shape, "ssim");
-  std::vector<double> band_sums(band_count(shape.height), 0.0);
-  for_each_band(shape.height, [&](int band, int r0, int r1) {
-    band_sums[band] = ForwardBand<T>(x, y, shape, map, partials).run(r0, r1);
+  std::vector<double> box_sums(boxes.size(), 0.0);
+  for_each_box(boxes, [&](int64_t i, const PixelBox& box) {
+    box_sums[i] = ForwardBox<T>(x, y, shape, box, map, partials).run();
   });
   double sum = 0;
-  for (double s : band_sums) sum += s;
-  return sum / double(shape.values());
+  for (double s : box_sums) sum += s;
+  return sum;
+}
+
+template <typename T>
+void ssim_backward_in(const T* x, const T* y, const ImageShape& shape,
+                      const std::vector<PixelBox>& boxes, const T* partials, const T* weight,
+                      T* grad_x) {
+  check_shape(shape, "ssim_backward");
+  for_each_box(boxes, [&](int64_t, const PixelBox& box) {
+    BackwardBox<T>(x, y, shape, box, partials, weight, grad_x).run();
+  });
+}
+
+template <typename T>
+double ssim(const T* x, const T* y, const ImageShape& shape, T* map, T* partials) {
+  return ssim_in(x, y, shape, bands(shape), map, partials) / double(shape.values());
 }
 
 template <typename T>
 void ssim_backward(const T* x, const T* y, const ImageShape& shape, const T* partials,
                    const T* weight, T* grad_x) {
-  check_shape(shape, "ssim_backward");
-  for_each_band(shape.height, [&](int, int r0, int r1) {
-    BackwardBand<T>(x, y, shape, partials, weight, grad_x).run(r0, r1);
-  });
+  ssim_backward_in(x, y, shape, bands(shape), partials, weight, grad_x);
 }
 
-template double ssim(const float*, const float*, const ImageShape&, float*, float*);
-template double ssim(const double*, const double*, const ImageShape&, double*, double*);
-template void ssim_backward(const float*, const float*, const ImageShape&, const float*,
-                            const float*, float*);
-template void ssim_backward(const double*, const double*, const ImageShape&, const double*,
-                            const double*, double*);
+#define IESRGS_INSTANTIATE_SSIM(T)                                                                 \
+  template SsimSupport ssim_support(const T*, const ImageShape&);                                  \
+  template double ssim_in(const T*, const T*, const ImageShape&, const std::vector<PixelBox>&, T*, \
+                          T*);                                                                     \
+  template void ssim_backward_in(const T*, const T*, const ImageShape&,                            \
+                                 const std::vector<PixelBox>&, const T*, const T*, T*);            \
+  template double ssim(const T*, const T*, const ImageShape&, T*, T*);                             \
+  template void ssim_backward(const T*, const T*, const ImageShape&, const T*, const T*, T*);
+IESRGS_INSTANTIATE_SSIM(float)
+IESRGS_INSTANTIATE_SSIM(double)
+#undef IESRGS_INSTANTIATE_SSIM
 
 }  // namespace iesrgs::loss

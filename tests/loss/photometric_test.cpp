@@ -87,5 +87,39 @@ TEST(Photometric, GradientMatchesFiniteDifferences) {
   loss_testing::expect_gradient_near(gradient, numeric_gradient(x, loss), 1e-4);
 }
 
+// Weights that vanish but on a few pixels take the tiled SSIM path; it must give what the whole
+// image gives.
+TEST(Photometric, SparseWeightsGiveTheLossAndGradientOfTheWholeImage) {
+  const ImageShape shape{80, 70, 3};
+  const std::vector<double> x = random_values(shape.values(), 9, 0.0, 0.5);
+  const std::vector<double> y = random_values(shape.values(), 10, 0.55, 1.0);
+  std::vector<double> weight(shape.pixels(), 0.0);
+  for (size_t p : {size_t(0), size_t(33 * 80 + 31), size_t(69 * 80 + 79)}) weight[p] = 0.3;
+  ASSERT_LT(2 * ssim_support(weight.data(), shape).weighted.size(),
+            ssim_support(weight.data(), shape).tiles);
+
+  std::vector<double> map(shape.pixels());
+  photometric_map(x.data(), y.data(), shape, kDssimWeight, map.data());
+  double expected = 0;
+  for (size_t p = 0; p < map.size(); ++p) expected += weight[p] * map[p];
+  std::vector<double> expected_gradient(shape.values(), 0.0), partials(ssim_partials_size(shape));
+  std::vector<double> l1_weight(weight), ssim_weight(weight);
+  for (size_t p = 0; p < weight.size(); ++p) {
+    l1_weight[p] *= 1 - kDssimWeight;
+    ssim_weight[p] *= -kDssimWeight;
+  }
+  l1_backward(x.data(), y.data(), shape, l1_weight.data(), expected_gradient.data());
+  ssim<double>(x.data(), y.data(), shape, nullptr, partials.data());
+  ssim_backward(x.data(), y.data(), shape, partials.data(), ssim_weight.data(),
+                expected_gradient.data());
+
+  std::vector<double> gradient(shape.values(), 0.0);
+  EXPECT_NEAR(weighted_photometric_loss(x.data(), y.data(), shape, kDssimWeight, weight.data(),
+                                        gradient.data()),
+              expected, 1e-12);
+  for (size_t i = 0; i < gradient.size(); ++i)
+    EXPECT_NEAR(gradient[i], expected_gradient[i], 1e-15) << i;
+}
+
 }  // namespace
 }  // namespace iesrgs::loss

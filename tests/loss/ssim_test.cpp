@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "loss/loss_test_support.hpp"
@@ -178,6 +180,86 @@ TEST(Ssim, BackwardAddsToTheGradient) {
   ssim_backward<double>(pair.x.data(), pair.y.data(), pair.shape, partials.data(), weight.data(),
                         twice.data());
   for (size_t i = 0; i < once.size(); ++i) EXPECT_DOUBLE_EQ(twice[i], 2 * once[i]);
+}
+
+TEST(Ssim, SupportHoldsTheWeightedTilesAndThoseWithinTheWindowOfThem) {
+  constexpr int kTile = kSsimTile;
+  const ImageShape shape{kTile + 13, 2 * kTile + 6, 3};  // 3 rows of 2 tiles, the last ones cut
+  std::vector<float> weight(shape.pixels(), 0.f);
+  const SsimSupport none = ssim_support(weight.data(), shape);
+  EXPECT_EQ(none.tiles, 6u);
+  EXPECT_TRUE(none.weighted.empty());
+  EXPECT_TRUE(none.reached.empty());
+
+  // Tile (0, 1); its window reaches tile rows 0 and 1, and tile column 1 only.
+  weight[size_t(kTile - 2) * shape.width + kTile + 8] = -0.5f;
+  const SsimSupport one = ssim_support(weight.data(), shape);
+  const auto corners = [](const PixelBox& b) {
+    return std::vector<int>{b.row0, b.row1, b.col0, b.col1};
+  };
+  ASSERT_EQ(one.weighted.size(), 1u);
+  EXPECT_EQ(corners(one.weighted[0]), std::vector<int>({0, kTile, kTile, kTile + 13}));
+  ASSERT_EQ(one.reached.size(), 2u);
+  EXPECT_EQ(corners(one.reached[0]), corners(one.weighted[0]));
+  EXPECT_EQ(corners(one.reached[1]), std::vector<int>({kTile, 2 * kTile, kTile, kTile + 13}));
+}
+
+// A weight that is zero but for a few pixels, some at tile and image borders.
+std::vector<double> sparse_weight(const ImageShape& shape) {
+  std::vector<double> weight(shape.pixels(), 0.0);
+  constexpr int kTile = kSsimTile;
+  for (const auto& [r, col] : std::vector<std::pair<int, int>>{
+           {0, 0}, {kTile - 1, kTile}, {kTile + 1, 5}, {66, 44}, {40, 20}, {40, 21}})
+    weight[size_t(r) * shape.width + col] = 0.1 + 0.01 * r;
+  return weight;
+}
+
+TEST(Ssim, BoxesComputeTheWholeImageMapOnTheirPixelsOnly) {
+  const ImagePair pair = textured_pair({45, 70, 3}, 10);
+  std::vector<double> whole_partials(ssim_partials_size(pair.shape));
+  std::vector<double> whole = ssim_map(pair.x, pair.y, pair.shape);
+  ssim<double>(pair.x.data(), pair.y.data(), pair.shape, nullptr, whole_partials.data());
+
+  const SsimSupport support = ssim_support(sparse_weight(pair.shape).data(), pair.shape);
+  std::vector<double> map(pair.shape.pixels(), -7.0);
+  std::vector<double> partials(whole_partials.size(), -7.0);
+  const double sum = ssim_in<double>(pair.x.data(), pair.y.data(), pair.shape, support.weighted,
+                                     map.data(), partials.data());
+  double expected_sum = 0;
+  size_t inside = 0;
+  for (int r = 0; r < pair.shape.height; ++r)
+    for (int col = 0; col < pair.shape.width; ++col) {
+      const size_t p = size_t(r) * pair.shape.width + col;
+      const bool in_box =
+          std::any_of(support.weighted.begin(), support.weighted.end(), [&](const PixelBox& b) {
+            return r >= b.row0 && r < b.row1 && col >= b.col0 && col < b.col1;
+          });
+      inside += in_box;
+      EXPECT_EQ(map[p], in_box ? whole[p] : -7.0) << r << "," << col;
+      if (in_box) expected_sum += whole[p] * pair.shape.channels;
+      for (int i = 0; i < 3 * pair.shape.channels; ++i)
+        EXPECT_EQ(partials[i * pair.shape.pixels() + p],
+                  in_box ? whole_partials[i * pair.shape.pixels() + p] : -7.0);
+    }
+  EXPECT_GT(inside, 0u);
+  EXPECT_LT(inside, pair.shape.pixels());
+  EXPECT_NEAR(sum, expected_sum, 1e-9);
+}
+
+TEST(Ssim, BackwardOnTheReachedTilesEqualsTheWholeImageBackward) {
+  const ImagePair pair = textured_pair({45, 70, 3}, 11);
+  const std::vector<double> weight = sparse_weight(pair.shape);
+  const std::vector<double> expected = weighted_gradient(pair, weight);
+
+  const SsimSupport support = ssim_support(weight.data(), pair.shape);
+  ASSERT_LT(support.reached.size(), support.tiles);
+  std::vector<double> partials(ssim_partials_size(pair.shape), 0.0);
+  ssim_in<double>(pair.x.data(), pair.y.data(), pair.shape, support.weighted, nullptr,
+                  partials.data());
+  std::vector<double> gradient(pair.shape.values(), 0.0);
+  ssim_backward_in<double>(pair.x.data(), pair.y.data(), pair.shape, support.reached,
+                           partials.data(), weight.data(), gradient.data());
+  for (size_t i = 0; i < gradient.size(); ++i) EXPECT_NEAR(gradient[i], expected[i], 1e-15) << i;
 }
 
 TEST(Ssim, EmptyImageIsAnError) {
