@@ -78,9 +78,8 @@ double weighted_photometric_loss(const T* x, const T* y, const ImageShape& shape
                                  const T* weight, T* grad_x) {
   check_shape(shape, "weighted_photometric_loss");
   const size_t pixels = shape.pixels();
-  // Tiles beat whole-width bands once most of them can be skipped.
   const SsimSupport support = ssim_support(weight, shape);
-  const bool sparse = 2 * support.weighted.size() < support.tiles;
+  const bool sparse = support.sparse();
   std::vector<T> ssim_map(pixels);
   std::vector<T> partials(grad_x ? ssim_partials_size(shape) : 0);
   T* partials_out = grad_x ? partials.data() : nullptr;

@@ -378,26 +378,38 @@ SsimSupport ssim_support(const T* weight, const ImageShape& shape) {
   check_shape(shape, "ssim_support");
   const int tile_rows = (shape.height + kSsimTile - 1) / kSsimTile;
   const int tile_cols = (shape.width + kSsimTile - 1) / kSsimTile;
-  std::vector<uint8_t> weighted(size_t(tile_rows) * tile_cols, 0), reached(weighted.size(), 0);
+  const auto boxes_of = [&](const std::vector<uint8_t>& flags) {
+    std::vector<PixelBox> boxes;
+    for (int tr = 0; tr < tile_rows; ++tr)
+      for (int tc = 0; tc < tile_cols; ++tc)
+        if (flags[size_t(tr) * tile_cols + tc])
+          boxes.push_back({tr * kSsimTile, std::min(shape.height, (tr + 1) * kSsimTile),
+                           tc * kSsimTile, std::min(shape.width, (tc + 1) * kSsimTile)});
+    return boxes;
+  };
+  std::vector<uint8_t> weighted(size_t(tile_rows) * tile_cols, 0);
   for (int r = 0; r < shape.height; ++r)
-    for (int col = 0; col < shape.width; ++col) {
-      if (weight[size_t(r) * shape.width + col] == 0) continue;
-      weighted[size_t(r / kSsimTile) * tile_cols + col / kSsimTile] = 1;
-      for (int tr = std::max(0, r - kRadius) / kSsimTile;
-           tr <= std::min(shape.height - 1, r + kRadius) / kSsimTile; ++tr)
-        for (int tc = std::max(0, col - kRadius) / kSsimTile;
-             tc <= std::min(shape.width - 1, col + kRadius) / kSsimTile; ++tc)
-          reached[size_t(tr) * tile_cols + tc] = 1;
-    }
+    for (int col = 0; col < shape.width; ++col)
+      if (weight[size_t(r) * shape.width + col] != 0)
+        weighted[size_t(r / kSsimTile) * tile_cols + col / kSsimTile] = 1;
   SsimSupport support;
   support.tiles = weighted.size();
-  for (int tr = 0; tr < tile_rows; ++tr)
-    for (int tc = 0; tc < tile_cols; ++tc) {
-      const PixelBox tile{tr * kSsimTile, std::min(shape.height, (tr + 1) * kSsimTile),
-                          tc * kSsimTile, std::min(shape.width, (tc + 1) * kSsimTile)};
-      if (weighted[size_t(tr) * tile_cols + tc]) support.weighted.push_back(tile);
-      if (reached[size_t(tr) * tile_cols + tc]) support.reached.push_back(tile);
-    }
+  support.weighted = boxes_of(weighted);
+  if (!support.sparse()) return support;
+
+  // The window of a weighted pixel reaches at most the tiles around its own.
+  std::vector<uint8_t> reached(weighted.size(), 0);
+  for (const PixelBox& tile : support.weighted)
+    for (int r = tile.row0; r < tile.row1; ++r)
+      for (int col = tile.col0; col < tile.col1; ++col) {
+        if (weight[size_t(r) * shape.width + col] == 0) continue;
+        for (int tr = std::max(0, r - kRadius) / kSsimTile;
+             tr <= std::min(shape.height - 1, r + kRadius) / kSsimTile; ++tr)
+          for (int tc = std::max(0, col - kRadius) / kSsimTile;
+               tc <= std::min(shape.width - 1, col + kRadius) / kSsimTile; ++tc)
+            reached[size_t(tr) * tile_cols + tc] = 1;
+      }
+  support.reached = boxes_of(reached);
   return support;
 }
 

@@ -46,11 +46,14 @@ struct PixelBox {
 };
 
 // Where sum_p weight[p] * map[p] needs work: the tiles holding a nonzero weight (whose map and
-// partials the forward pass needs) and the tiles within the window's radius of one (the only
-// pixels with a gradient), out of `tiles` in the whole grid.
+// partials the forward pass needs) and, when they are sparse, the tiles within the window's
+// radius of one (the only pixels with a gradient), out of `tiles` in the whole grid.
 struct SsimSupport {
   std::vector<PixelBox> weighted, reached;
   size_t tiles = 0;
+
+  // Tiles beat whole-width bands once most of them can be skipped; `reached` is empty otherwise.
+  bool sparse() const { return 2 * weighted.size() < tiles; }
 };
 
 template <typename T>
