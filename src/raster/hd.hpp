@@ -16,12 +16,14 @@ namespace iesrgs::hd {
 using ::ceil;
 using ::exp;
 using ::floor;
+using ::isfinite;
 using ::log;
 using ::sqrt;
 #else
 using std::ceil;
 using std::exp;
 using std::floor;
+using std::isfinite;
 using std::log;
 using std::sqrt;
 #endif

@@ -77,7 +77,7 @@ IESRGS_HD bool project(const GaussianParams<T>& g, int i, const RasterCamera<T>&
   const Vec3T<T> mean{g.means[3 * i], g.means[3 * i + 1], g.means[3 * i + 2]};
   p.view = mul(w, mean) + Vec3T<T>{cam.translation[0], cam.translation[1], cam.translation[2]};
   const T z = p.view.z;
-  if (z <= T(kNearPlane)) return false;
+  if (!(z > T(kNearPlane))) return false;  // also culls a non-finite mean
 
   for (int k = 0; k < 3; ++k) p.scale[k] = hd::exp(g.log_scales[3 * i + k]);
   p.opacity3d = gs::filter3d(p.scale, g.filter_std ? g.filter_std[i] : T(0), p.var);
@@ -152,13 +152,16 @@ IESRGS_HD Splat<T> make_splat(const GaussianParams<T>& g, int i, const RasterCam
 template <typename T>
 IESRGS_HD PixelRect splat_rect(const Splat<T>& s, const Projection<T>& p, int width, int height) {
   PixelRect rect{0, 0, 0, 0};
-  if (!(s.cutoff > T(0))) return rect;
   const T hx = hd::sqrt(s.cutoff * p.filtered.xx), hy = hd::sqrt(s.cutoff * p.filtered.yy);
-  // Pixel i has its center at i + 0.5; clamp in floating point before converting.
-  rect.x0 = int(hd::max(T(0), hd::ceil(s.x - hx - T(0.5))));
-  rect.y0 = int(hd::max(T(0), hd::ceil(s.y - hy - T(0.5))));
-  rect.x1 = int(hd::min(T(width), hd::floor(s.x + hx - T(0.5)) + T(1)));
-  rect.y1 = int(hd::min(T(height), hd::floor(s.y + hy - T(0.5)) + T(1)));
+  // A diverged Gaussian (non-finite center or extent) covers nothing instead of every pixel.
+  if (!(s.cutoff > T(0)) || !hd::isfinite(s.x + hx) || !hd::isfinite(s.y + hy)) return rect;
+  // Pixel i has its center at i + 0.5; clamp to the image in floating point before converting,
+  // so that a center far off screen cannot overflow an int.
+  const auto clamp = [](T v, int hi) { return int(hd::min(T(hi), hd::max(T(0), v))); };
+  rect.x0 = clamp(hd::ceil(s.x - hx - T(0.5)), width);
+  rect.y0 = clamp(hd::ceil(s.y - hy - T(0.5)), height);
+  rect.x1 = clamp(hd::floor(s.x + hx - T(0.5)) + T(1), width);
+  rect.y1 = clamp(hd::floor(s.y + hy - T(0.5)) + T(1), height);
   if (rect.empty()) rect = {0, 0, 0, 0};
   return rect;
 }

@@ -156,7 +156,7 @@ double Trainer::step(int64_t iteration) {
     total += loss.item<double>();
     view_stats.push_back({probes.grad.grad(), probes.abs_grad.grad(), render.radii});
   }
-  check_finite(iteration, total);
+  if (!std::isfinite(total)) fail_diverged(iteration, total);
   if (iteration < config_.densify_until) stats_.accumulate(view_stats);
   optimizer_->step(model_);
   for (int p = 0; p < gs::kParamCount; ++p)
@@ -187,9 +187,11 @@ void Trainer::densify(int64_t iteration) {
   }
 }
 
-void Trainer::check_finite(int64_t iteration, double loss) const {
-  const bool params_checked = iteration % 100 == 0;
-  if (std::isfinite(loss) && (!params_checked || all_finite(model_))) return;
+void Trainer::check_parameters(int64_t iteration, double loss) const {
+  if (!all_finite(model_)) fail_diverged(iteration, loss);
+}
+
+void Trainer::fail_diverged(int64_t iteration, double loss) const {
   const std::string kept =
       checkpoint_iteration_ >= 0
           ? fmt::format("the last good checkpoint (iteration {}) is kept in {}",
@@ -232,6 +234,9 @@ TrainSummary Trainer::run() {
     loss = step(iteration_ + 1);
     ++iteration_;
     const bool last = iteration_ == config_.iterations;
+    // The parameters are checked after the optimizer step, and not every step (a reduction over
+    // the whole model): a divergence shows within 100 iterations and never reaches the outputs.
+    if (iteration_ % 100 == 0 || last) check_parameters(iteration_, loss);
     std::optional<double> test_psnr;
     if (!setup_.test_views.empty() && config_.test_every > 0 &&
         (iteration_ % config_.test_every == 0 || last)) {

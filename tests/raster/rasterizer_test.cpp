@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <limits>
+#include <utility>
+
 #include "core/error.hpp"
 #include "raster_test_scene.hpp"
 #include "reference_renderer.hpp"
@@ -180,6 +183,39 @@ TEST(RasterForward, RejectsInvalidInput) {
   s.sh_degree = 3;
   cam.intrinsics.width = 0;
   EXPECT_THROW(kernel_render(s, cam, bg), Error);
+}
+
+TEST(RasterForward, DivergedGaussiansCoverNothing) {
+  // Training that diverges leaves non-finite or huge parameters; each such Gaussian must be
+  // culled, not turned into a box of every pixel (or of 2^31 of them), and the rest must render
+  // as without it.
+  const Camera cam = test_camera(24, 20);
+  const Scene<float> healthy = random_scene(cam, 12, 1, 4).cast<float>();
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Scene<double> diverged;
+  diverged.add({inf, 0, 3}, {-2, -2, -2}, {1, 0, 0, 0}, 2, {1, 0, 0}, 0);
+  diverged.add({0, nan, 3}, {-2, -2, -2}, {1, 0, 0, 0}, 2, {1, 0, 0}, 0);
+  diverged.add({1e30, 0, 3}, {-2, -2, -2}, {1, 0, 0, 0}, 2, {1, 0, 0}, 0);
+  diverged.add({0, 0, 3}, {inf, -2, -2}, {1, 0, 0, 0}, 2, {1, 0, 0}, 0);
+  diverged.add({0, 0, 3}, {-2, nan, -2}, {1, 0, 0, 0}, 2, {1, 0, 0}, 0);
+  diverged.add({0, 0, 3}, {-2, -2, -2}, {1, 0, 0, 0}, nan, {1, 0, 0}, 0);
+  Scene<float> mixed = healthy;
+  const Scene<float> bad = diverged.cast<float>();
+  for (auto [to, from] : {std::pair{&mixed.means, &bad.means},
+                          {&mixed.log_scales, &bad.log_scales},
+                          {&mixed.quats, &bad.quats},
+                          {&mixed.opacity_logits, &bad.opacity_logits},
+                          {&mixed.sh, &bad.sh},
+                          {&mixed.filter_std, &bad.filter_std}})
+    to->insert(to->end(), from->begin(), from->end());
+
+  const float bg[3] = {0.3f, 0.3f, 0.3f};
+  const KernelRender<float> expected = kernel_render(healthy, cam, bg);
+  const KernelRender<float> r = kernel_render(mixed, cam, bg);
+  EXPECT_EQ(r.image, expected.image);
+  EXPECT_EQ(r.alpha, expected.alpha);
+  for (int i = healthy.count(); i < mixed.count(); ++i) EXPECT_EQ(r.radii[size_t(i)], 0) << i;
 }
 
 TEST(RasterForward, EmptySceneShowsBackground) {

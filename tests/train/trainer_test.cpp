@@ -135,6 +135,17 @@ TEST_F(TrainerTest, NonFiniteLossStopsWithTheCheckpointNamed) {
   EXPECT_NE(message.find("checkpoint.pt"), std::string::npos) << message;
 }
 
+TEST_F(TrainerTest, NonFiniteParametersStopTrainingBeforeItEnds) {
+  // A learning rate past float's range makes the opacities infinite while the loss stays finite:
+  // 40 iterations never reach a periodic check, so the last one must catch it.
+  TempDir out;
+  TrainConfig c = config();
+  c.learning_rates.opacity = 1e39;
+  Trainer trainer(c, setup(out.path()), initial());
+  const std::string message = error_message([&] { trainer.run(); });
+  EXPECT_NE(message.find("training diverged at iteration"), std::string::npos) << message;
+}
+
 TEST_F(TrainerTest, ResumeWithoutCheckpointIsAClearError) {
   TempDir out;
   Trainer trainer(config(), setup(out.path()), initial());
