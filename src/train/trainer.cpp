@@ -187,10 +187,6 @@ void Trainer::densify(int64_t iteration) {
   }
 }
 
-void Trainer::check_parameters(int64_t iteration, double loss) const {
-  if (!all_finite(model_)) fail_diverged(iteration, loss);
-}
-
 void Trainer::fail_diverged(int64_t iteration, double loss) const {
   const std::string kept =
       checkpoint_iteration_ >= 0
@@ -236,7 +232,7 @@ TrainSummary Trainer::run() {
     const bool last = iteration_ == config_.iterations;
     // The parameters are checked after the optimizer step, and not every step (a reduction over
     // the whole model): a divergence shows within 100 iterations and never reaches the outputs.
-    if (iteration_ % 100 == 0 || last) check_parameters(iteration_, loss);
+    if ((iteration_ % 100 == 0 || last) && !all_finite(model_)) fail_diverged(iteration_, loss);
     std::optional<double> test_psnr;
     if (!setup_.test_views.empty() && config_.test_every > 0 &&
         (iteration_ % config_.test_every == 0 || last)) {

@@ -70,7 +70,6 @@ class Trainer {
   std::vector<int> pick_views();
   void densify(int64_t iteration);
   void save_checkpoint();
-  void check_parameters(int64_t iteration, double loss) const;
   [[noreturn]] void fail_diverged(int64_t iteration, double loss) const;
   double report_test_psnr();
 
