@@ -59,6 +59,8 @@ class GroundTruth {
     }
   }
 
+  const float* background() const { return background_.data(); }
+
   Image get(const std::string& name) {
     if (scene_) {
       const auto found = cameras_.find(name);
@@ -100,9 +102,9 @@ void run_eval(const EvalArgs& args) {
   const std::vector<std::filesystem::path> files = render_files(args.renders);
   for (size_t i = 0; i < files.size(); ++i) {
     const std::string name = files[i].stem().string();
-    const Image render = to_float(read_image8(files[i]));
+    // RGBA renders (other tools save them) are composited like the ground truth.
+    const Image render = composite_rgb(read_image8(files[i]), truth.background());
     const Image reference = truth.get(name);
-    if (render.channels != 3) fail_file(files[i], "is not an RGB image");
     try {
       report.views.push_back(
           pipeline::measure_view(name, render, reference, lpips ? &*lpips : nullptr));
@@ -143,7 +145,8 @@ void add_eval_command(CLI::App& app) {
   command->add_option("--downscale", args->downscale, "Ground-truth scene resolution 1/k")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  command->add_option("--background", args->background, "Background for RGBA ground truth")
+  command
+      ->add_option("--background", args->background, "Background for RGBA renders and ground truth")
       ->capture_default_str();
   command
       ->add_option("--lpips", args->lpips,

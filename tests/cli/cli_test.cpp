@@ -1,6 +1,7 @@
 // End-to-end checks of the iesrgs binary: exit codes and one-line errors as a user sees them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <tuple>
@@ -86,6 +87,22 @@ TEST(Cli, UpscaleOfAMissingInputNamesIt) {
   EXPECT_EQ(run.status, 1);
   EXPECT_EQ(last_line(run.output),
             "error: " + (dir / "nothing.png").string() + ": no such image or folder");
+}
+
+TEST(Cli, EvalCompositesRgbaRendersOverTheBackground) {
+  TempDir dir;
+  Image8 transparent(8, 8, 4);  // black, alpha 0: the background everywhere
+  Image8 white(8, 8, 3);
+  std::fill(white.data.begin(), white.data.end(), uint8_t(255));
+  write_png(dir / "renders" / "r_0.png", transparent);
+  write_png(dir / "truth" / "r_0.png", white);
+  const std::string folders = (dir / "renders").string() + " " + (dir / "truth").string();
+  const CliRun on_white = iesrgs("eval --lpips none " + folders);
+  EXPECT_EQ(on_white.status, 0) << on_white.output;
+  EXPECT_TRUE(contains(on_white.output, "1 views: PSNR inf dB, SSIM 1.0000")) << on_white.output;
+  const CliRun on_black = iesrgs("eval --lpips none --background black " + folders);
+  EXPECT_EQ(on_black.status, 0) << on_black.output;
+  EXPECT_TRUE(contains(on_black.output, "1 views: PSNR 0.000 dB")) << on_black.output;
 }
 
 }  // namespace
