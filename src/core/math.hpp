@@ -5,6 +5,8 @@
 
 namespace iesrgs {
 
+inline constexpr double kPi = 3.14159265358979323846;
+
 struct Vec3 {
   double x = 0, y = 0, z = 0;
 
@@ -19,6 +21,10 @@ struct Vec3 {
   }
   double norm() const { return std::sqrt(dot(*this)); }
 };
+
+inline Vec3 normalized(const Vec3& v) {
+  return v * (1 / v.norm());
+}
 
 // Row-major 3x3 matrix.
 struct Mat3 {

@@ -7,12 +7,6 @@
 
 namespace iesrgs::synth {
 
-inline constexpr double kPi = 3.14159265358979323846;
-
-inline Vec3 normalized(const Vec3& v) {
-  return v * (1 / v.norm());
-}
-
 struct Ray {
   Vec3 origin;
   Vec3 direction;  // unit length, so hit distances are Euclidean
