@@ -1,5 +1,6 @@
 // iesrgs render: a trained model seen from a scene's cameras, at any resolution factor
-// (--scale 4 renders four times the cameras' resolution with the same field of view).
+// (--scale 4 renders four times the cameras' resolution with the same field of view), or along a
+// fly-around path fitted to the training cameras (--path orbit).
 #include <fmt/core.h>
 
 #include <nlohmann/json.hpp>
@@ -10,6 +11,7 @@
 #include "gs/model.hpp"
 #include "io/atomic_file.hpp"
 #include "io/ply.hpp"
+#include "pipeline/camera_path.hpp"
 #include "pipeline/render_views.hpp"
 
 namespace iesrgs::cli {
@@ -22,6 +24,8 @@ struct RenderArgs {
   std::string output;
   std::string split = "test";
   double scale = 1;
+  std::string path;
+  int frames = 120;
 };
 
 std::filesystem::path model_file(const std::filesystem::path& path) {
@@ -32,12 +36,19 @@ std::filesystem::path model_file(const std::filesystem::path& path) {
 void run_render(const RenderArgs& args) {
   const gs::GaussianModel model = gs::model_from_splat_cloud(read_ply(model_file(args.model)));
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
+  const std::string what = args.path.empty() ? args.split : args.path + " path";
   std::vector<Camera> cameras;
-  for (const Camera* camera : scene.split(args.split == "train" ? Split::Train : Split::Test))
-    cameras.push_back(*camera);
+  if (args.path.empty()) {
+    for (const Camera* camera : scene.split(args.split == "train" ? Split::Train : Split::Test))
+      cameras.push_back(*camera);
+  } else {
+    const std::vector<const Camera*> train = scene.split(Split::Train);
+    if (train.empty()) fail_file(scene.root, "has no training views to fit a camera path to");
+    cameras = pipeline::orbit_path(train, args.frames);
+  }
   if (cameras.empty()) fail_file(scene.root, fmt::format("has no {} views", args.split));
-  fmt::print("rendering {} {} views of {} Gaussians at x{}\n", cameras.size(), args.split,
-             model.size(), args.scale);
+  fmt::print("rendering {} {} views of {} Gaussians at x{}\n", cameras.size(), what, model.size(),
+             args.scale);
   const double seconds =
       pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
   const Camera first = cameras.front().scaled(args.scale);
@@ -63,6 +74,15 @@ void add_render_command(CLI::App& app) {
       ->check(CLI::IsMember({"train", "test"}))
       ->capture_default_str();
   command->add_option("--scale", args->scale, "Resolution factor over the cameras' (SR-splatting)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command
+      ->add_option("--path", args->path,
+                   "Render a fly-around instead of --split: an orbit fitted to the training "
+                   "cameras (or a sweep along the arc they cover), looking at the point they "
+                   "look at (frames path_0000.png, ...)")
+      ->check(CLI::IsMember({"orbit"}));
+  command->add_option("--frames", args->frames, "Frames of --path")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   command->callback([args] { run_render(*args); });

@@ -56,6 +56,14 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   EXPECT_EQ(mismatch.status, 1);
   EXPECT_TRUE(contains(last_line(mismatch.output), "64x64 but its reference is 32x32"))
       << mismatch.output;
+
+  const CliRun orbit = iesrgs("render " + out + " " + scene + " -o " + (dir / "orbit").string() +
+                              " --path orbit --frames 3");
+  ASSERT_EQ(orbit.status, 0) << orbit.output;
+  EXPECT_TRUE(contains(orbit.output, "rendering 3 orbit path views")) << orbit.output;
+  for (const char* frame : {"path_0000", "path_0001", "path_0002"})
+    EXPECT_EQ(read_image_header(dir / "orbit" / "rgb" / (std::string(frame) + ".png")).width, 32)
+        << frame;
 }
 
 TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModel) {

@@ -1,0 +1,189 @@
+#include "pipeline/camera_path.hpp"
+
+#include <fmt/core.h>
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace iesrgs::pipeline {
+
+namespace {
+
+// Cameras that leave this much of the turn around their focus point uncovered get a sweep along
+// the arc they cover instead of the whole ellipse, which would look at the scene from behind.
+constexpr double kLargestGapForAFullTurn = kPi / 2;
+
+// A camera's axis in world coordinates: a row of its world-to-camera rotation (OpenCV: 0 right,
+// 1 down, 2 forward).
+Vec3 camera_axis(const Camera& camera, int axis) {
+  return {camera.rotation(axis, 0), camera.rotation(axis, 1), camera.rotation(axis, 2)};
+}
+
+double determinant(const Mat3& a) {
+  return a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) -
+         a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
+         a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
+}
+
+// Cramer's rule; the caller checks that `a` is well conditioned.
+Vec3 solve(const Mat3& a, const Vec3& b) {
+  const double det = determinant(a);
+  double x[3];
+  for (int column = 0; column < 3; ++column) {
+    Mat3 replaced = a;
+    for (int row = 0; row < 3; ++row) replaced(row, column) = b[row];
+    x[column] = determinant(replaced) / det;
+  }
+  return {x[0], x[1], x[2]};
+}
+
+// Where the training cameras stand around their focus point: the world's up direction, the ellipse
+// fitted to their positions in the plane across it, and their mean height.
+struct Ring {
+  Vec3 focus, up, major, minor;
+  double radius_major = 0, radius_minor = 0, mean_radius = 0, height = 0;
+  std::vector<double> angles;  // of each camera around `up`, from `major` towards `minor`
+};
+
+// People hold cameras level, so the world's up is the direction most nearly perpendicular to
+// every camera's right axis (the mean image up tilts towards what cameras look down at). Only
+// when all right axes are parallel does it fall back to the mean image up.
+Vec3 up_direction(const std::vector<const Camera*>& cameras) {
+  Vec3 mean_up;
+  torch::Tensor moments = torch::zeros({3, 3}, torch::kFloat64);
+  auto m = moments.accessor<double, 2>();
+  for (const Camera* camera : cameras) {
+    mean_up = mean_up - camera_axis(*camera, 1);
+    const Vec3 right = camera_axis(*camera, 0);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) m[i][j] += right[i] * right[j];
+  }
+  mean_up = normalized(mean_up);
+  const auto [values, vectors] = torch::linalg::eigh(moments, "L");  // ascending
+  if (values[1].item<double>() < 1e-3 * double(cameras.size())) return mean_up;
+  const auto v = vectors.accessor<double, 2>();
+  const Vec3 up{v[0][0], v[1][0], v[2][0]};
+  return up.dot(mean_up) < 0 ? -up : up;
+}
+
+Ring fit_ring(const std::vector<const Camera*>& cameras) {
+  Ring ring;
+  ring.focus = focus_point(cameras);
+  ring.up = up_direction(cameras);
+  // Any orthonormal basis of the plane across `up`.
+  const Vec3 e1 =
+      normalized(ring.up.cross(std::abs(ring.up.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
+  const Vec3 e2 = ring.up.cross(e1);
+  double sxx = 0, syy = 0, sxy = 0;
+  const double n = double(cameras.size());
+  for (const Camera* camera : cameras) {
+    const Vec3 offset = camera->center() - ring.focus;
+    const double x = offset.dot(e1), y = offset.dot(e2);
+    sxx += x * x / n;
+    syy += y * y / n;
+    sxy += x * y / n;
+    ring.mean_radius += std::hypot(x, y) / n;
+    ring.height += offset.dot(ring.up) / n;
+  }
+  // Principal axes of the second moments; points spread evenly over an ellipse with semi-axis r
+  // have a second moment of r^2 / 2 along it.
+  const double angle = 0.5 * std::atan2(2 * sxy, sxx - syy);
+  const double c = std::cos(angle), s = std::sin(angle);
+  ring.major = e1 * c + e2 * s;
+  ring.minor = ring.up.cross(ring.major);
+  const double along_major = sxx * c * c + syy * s * s + 2 * sxy * s * c;
+  ring.radius_major = std::sqrt(2 * std::max(along_major, 0.0));
+  ring.radius_minor = std::sqrt(2 * std::max(sxx + syy - along_major, 0.0));
+  for (const Camera* camera : cameras) {
+    const Vec3 offset = camera->center() - ring.focus;
+    ring.angles.push_back(std::atan2(offset.dot(ring.minor), offset.dot(ring.major)));
+  }
+  std::sort(ring.angles.begin(), ring.angles.end());
+  return ring;
+}
+
+// The arc the cameras cover: where it starts (just after the largest gap between neighbouring
+// cameras) and how far it reaches.
+struct Arc {
+  double start = 0, span = 0;
+};
+
+Arc covered_arc(const std::vector<double>& sorted_angles) {
+  double gap = sorted_angles.front() + 2 * kPi - sorted_angles.back();
+  double start = sorted_angles.front();
+  for (size_t i = 1; i < sorted_angles.size(); ++i) {
+    if (sorted_angles[i] - sorted_angles[i - 1] > gap) {
+      gap = sorted_angles[i] - sorted_angles[i - 1];
+      start = sorted_angles[i];
+    }
+  }
+  return {start, 2 * kPi - gap};
+}
+
+// World-to-camera pose of a camera at `eye` looking at `target` with `up` pointing up in the
+// image (OpenCV rows: right, down, forward).
+void look_at(Camera& camera, const Vec3& eye, const Vec3& target, const Vec3& up) {
+  const Vec3 forward = normalized(target - eye);
+  Vec3 right = forward.cross(up);
+  // Looking straight along `up`: any right vector across the view will do.
+  if (right.norm() < 1e-9)
+    right = forward.cross(std::abs(forward.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0});
+  right = normalized(right);
+  const Vec3 down = forward.cross(right);
+  camera.rotation.m = {right.x, right.y,   right.z,   down.x,   down.y,
+                       down.z,  forward.x, forward.y, forward.z};
+  camera.translation = -(camera.rotation * eye);
+}
+
+}  // namespace
+
+Vec3 focus_point(const std::vector<const Camera*>& cameras) {
+  // Minimizes sum_i |(I - d_i d_i^T)(p - c_i)|^2 over p: the normal equations below.
+  Mat3 a;
+  a.m.fill(0);
+  Vec3 b;
+  for (const Camera* camera : cameras) {
+    const Vec3 d = camera_axis(*camera, 2);
+    Mat3 projector;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) projector(i, j) = (i == j) - d[i] * d[j];
+    for (int k = 0; k < 9; ++k) a.m[k] += projector.m[k];
+    b = b + projector * camera->center();
+  }
+  // Parallel optical axes (one camera, or a rig of parallel cameras) meet nowhere.
+  if (std::abs(determinant(a)) < 1e-6 * std::pow(double(cameras.size()), 3))
+    fail("the {} training cameras look in parallel directions: no point to circle around",
+         cameras.size());
+  return solve(a, b);
+}
+
+std::vector<Camera> orbit_path(const std::vector<const Camera*>& cameras, int frames) {
+  if (cameras.empty()) fail("a camera path needs at least one training camera");
+  if (frames < 1) fail("a camera path needs at least one frame, got {}", frames);
+  const Ring ring = fit_ring(cameras);
+  const Arc arc = covered_arc(ring.angles);
+  const bool full_turn = 2 * kPi - arc.span <= kLargestGapForAFullTurn;
+  std::vector<Camera> path;
+  for (int k = 0; k < frames; ++k) {
+    const double phase = 2 * kPi * k / frames;
+    Vec3 around;
+    if (full_turn) {
+      around = ring.major * (ring.radius_major * std::cos(phase)) +
+               ring.minor * (ring.radius_minor * std::sin(phase));
+    } else {  // out along the arc and back, slowing down at its ends, so the video loops
+      const double t = arc.start + arc.span * (1 - std::cos(phase)) / 2;
+      around = (ring.major * std::cos(t) + ring.minor * std::sin(t)) * ring.mean_radius;
+    }
+    Camera camera = *cameras.front();
+    camera.name = fmt::format("path_{:04d}", k);
+    camera.image_path.clear();
+    look_at(camera, ring.focus + around + ring.up * ring.height, ring.focus, ring.up);
+    path.push_back(camera);
+  }
+  return path;
+}
+
+}  // namespace iesrgs::pipeline

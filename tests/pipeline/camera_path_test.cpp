@@ -1,0 +1,123 @@
+#include "pipeline/camera_path.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "support/expect_error.hpp"
+#include "synth/camera_path.hpp"
+
+namespace iesrgs::pipeline {
+namespace {
+
+// A camera at `eye` looking at `target`, world +z up, posed by the synthetic scene's own look-at.
+Camera camera_at(const Vec3& eye, const Vec3& target) {
+  const auto matrix = synth::look_at(eye, target).matrix();
+  double c2w[4][4];
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) c2w[r][c] = matrix[r][c];
+  Camera camera;
+  camera.name = "train";
+  camera.intrinsics = {64, 48, 50, 50, 32, 24};
+  opengl_c2w_to_opencv_w2c(c2w, camera.rotation, camera.translation);
+  return camera;
+}
+
+// Cameras evenly spaced on an ellipse with semi-axes a (rotated by `angle` from +x) and b, at
+// height z above `target`, all looking at it.
+std::vector<Camera> ring(double a, double b, double angle, double z, const Vec3& target, int n) {
+  std::vector<Camera> cameras;
+  for (int i = 0; i < n; ++i) {
+    const double t = 2 * kPi * i / n, x = a * std::cos(t), y = b * std::sin(t);
+    const Vec3 offset{x * std::cos(angle) - y * std::sin(angle),
+                      x * std::sin(angle) + y * std::cos(angle), z};
+    cameras.push_back(camera_at(target + offset, target));
+  }
+  return cameras;
+}
+
+std::vector<const Camera*> pointers(const std::vector<Camera>& cameras) {
+  std::vector<const Camera*> out;
+  for (const Camera& camera : cameras) out.push_back(&camera);
+  return out;
+}
+
+TEST(CameraPath, FocusPointIsWhereTheOpticalAxesMeet) {
+  const Vec3 target{0.3, -0.2, 0.5};
+  const std::vector<Camera> cameras = ring(3, 2, 0.4, 1.5, target, 7);
+  const Vec3 focus = focus_point(pointers(cameras));
+  EXPECT_NEAR((focus - target).norm(), 0, 1e-9);
+}
+
+TEST(CameraPath, CircleOfCamerasGivesThatCircleLookingAtItsCentre) {
+  const Vec3 target{1, 2, 0};
+  const std::vector<Camera> cameras = ring(3, 3, 0, 1, target, 8);
+  const std::vector<Camera> path = orbit_path(pointers(cameras), 12);
+  ASSERT_EQ(path.size(), 12u);
+  EXPECT_EQ(path[0].name, "path_0000");
+  EXPECT_EQ(path[11].name, "path_0011");
+  for (const Camera& camera : path) {
+    const Vec3 offset = camera.center() - target;
+    EXPECT_NEAR(std::hypot(offset.x, offset.y), 3, 1e-9);
+    EXPECT_NEAR(offset.z, 1, 1e-9);
+    // The target sits on the optical axis in front of the camera, world up is image up.
+    const Vec3 seen = camera.rotation * target + camera.translation;
+    EXPECT_NEAR(seen.x, 0, 1e-9);
+    EXPECT_NEAR(seen.y, 0, 1e-9);
+    EXPECT_GT(seen.z, 0);
+    EXPECT_LT(camera.rotation(1, 2), 0);  // the camera's down axis points down the world's z
+    EXPECT_EQ(camera.intrinsics.width, 64);
+    EXPECT_EQ(camera.intrinsics.fx, 50);
+  }
+}
+
+TEST(CameraPath, EllipseOfCamerasKeepsItsAxesAndOrientation) {
+  const double angle = 0.5;
+  const std::vector<Camera> cameras = ring(4, 2, angle, 0.5, {0, 0, 0}, 16);
+  const std::vector<Camera> path = orbit_path(pointers(cameras), 64);
+  double longest = 0, shortest = 1e9, longest_direction = 0;
+  for (const Camera& camera : path) {
+    const Vec3 c = camera.center();
+    const double r = std::hypot(c.x, c.y);
+    if (r > longest) longest = r, longest_direction = std::atan2(c.y, c.x);
+    shortest = std::min(shortest, r);
+    EXPECT_NEAR(c.z, 0.5, 1e-9);
+  }
+  EXPECT_NEAR(longest, 4, 1e-6);
+  EXPECT_NEAR(shortest, 2, 1e-6);
+  EXPECT_NEAR(std::remainder(longest_direction - angle, kPi), 0, 1e-6);
+}
+
+TEST(CameraPath, ArcOfCamerasGivesASweepAlongItAndBack) {
+  // Seven cameras over 120 degrees of a circle of radius 2, 0.8 above the target.
+  std::vector<Camera> cameras;
+  for (int i = 0; i < 7; ++i) {
+    const double t = (20.0 * i - 30) * kPi / 180;
+    cameras.push_back(camera_at({2 * std::cos(t), 2 * std::sin(t), 0.8}, {0, 0, 0}));
+  }
+  const std::vector<Camera> path = orbit_path(pointers(cameras), 20);
+  double lowest = kPi, highest = -kPi;
+  for (const Camera& camera : path) {
+    const Vec3 c = camera.center();
+    EXPECT_NEAR(std::hypot(c.x, c.y), 2, 1e-9);
+    EXPECT_NEAR(c.z, 0.8, 1e-9);
+    lowest = std::min(lowest, std::atan2(c.y, c.x));
+    highest = std::max(highest, std::atan2(c.y, c.x));
+  }
+  EXPECT_NEAR(lowest * 180 / kPi, -30, 1e-6);  // from one end of the arc
+  EXPECT_NEAR(highest * 180 / kPi, 90, 1e-6);  // to the other, at the middle frame
+  EXPECT_NEAR((path[1].center() - path[19].center()).norm(), 0, 1e-9);  // and back
+}
+
+TEST(CameraPath, ParallelCamerasAreAClearError) {
+  const std::vector<Camera> cameras = {camera_at({0, 0, 0}, {0, 5, 0}),
+                                       camera_at({1, 0, 0}, {1, 5, 0})};
+  const std::string message = testing::error_message([&] { orbit_path(pointers(cameras), 10); });
+  EXPECT_TRUE(testing::contains(message, "look in parallel directions")) << message;
+}
+
+}  // namespace
+}  // namespace iesrgs::pipeline
