@@ -2,6 +2,8 @@
 // Each subcommand lives in its own file and registers itself on the top-level app.
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
+
 namespace iesrgs::cli {
 
 void add_synth_command(CLI::App& app);
@@ -14,5 +16,11 @@ void add_depth_command(CLI::App& app);
 void add_upscale_command(CLI::App& app);
 void add_external_command(CLI::App& app);
 void add_run_command(CLI::App& app);
+void add_export_command(CLI::App& app);
+
+// A trained model given as its training folder (its point_cloud.ply) or as a .ply file.
+inline std::filesystem::path model_ply(const std::filesystem::path& path) {
+  return std::filesystem::is_directory(path) ? path / "point_cloud.ply" : path;
+}
 
 }  // namespace iesrgs::cli

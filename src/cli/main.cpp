@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   iesrgs::cli::add_upscale_command(app);
   iesrgs::cli::add_external_command(app);
   iesrgs::cli::add_run_command(app);
+  iesrgs::cli::add_export_command(app);
   // Whatever was printed before an error comes first, so the error is the last line.
   const auto report = [](const char* message) {
     std::fflush(stdout);

@@ -28,13 +28,8 @@ struct RenderArgs {
   int frames = 120;
 };
 
-std::filesystem::path model_file(const std::filesystem::path& path) {
-  if (std::filesystem::is_directory(path)) return path / "point_cloud.ply";
-  return path;
-}
-
 void run_render(const RenderArgs& args) {
-  const gs::GaussianModel model = gs::model_from_splat_cloud(read_ply(model_file(args.model)));
+  const gs::GaussianModel model = gs::model_from_splat_cloud(read_ply(model_ply(args.model)));
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   const std::string what = args.path.empty() ? args.split : args.path + " path";
   std::vector<Camera> cameras;

@@ -6,6 +6,8 @@
 namespace iesrgs {
 
 inline constexpr double kPi = 3.14159265358979323846;
+// The degree-0 real spherical harmonic, 1 / (2 sqrt(pi)): splat colour = 0.5 + kShC0 * f_dc.
+inline constexpr double kShC0 = 0.28209479177387814;
 
 struct Vec3 {
   double x = 0, y = 0, z = 0;

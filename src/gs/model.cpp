@@ -4,6 +4,7 @@
 #include <random>
 
 #include "core/error.hpp"
+#include "core/math.hpp"
 #include "gs/filter3d.hpp"
 #include "gs/neighbors.hpp"
 #include "gs/sh.hpp"
@@ -12,7 +13,6 @@ namespace iesrgs::gs {
 
 namespace {
 
-constexpr float kShC0 = 0.28209479177387814f;  // degree-0 SH basis value
 constexpr int kRestCoefficients = kShCoefficients - 1;
 
 torch::Tensor tensor_of(const std::vector<float>& values, c10::IntArrayRef shape) {
@@ -108,7 +108,7 @@ GaussianModel model_from_points(const std::vector<float>& positions,
   if (positions.size() % 3 != 0 || colors.size() != positions.size())
     fail("initial points: {} coordinates and {} color values", positions.size(), colors.size());
   std::vector<float> dc(colors.size());
-  for (size_t i = 0; i < colors.size(); ++i) dc[i] = (colors[i] - 0.5f) / kShC0;
+  for (size_t i = 0; i < colors.size(); ++i) dc[i] = (colors[i] - 0.5f) / float(kShC0);
   return model_from_positions_and_dc(positions, dc);
 }
 

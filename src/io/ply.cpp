@@ -127,24 +127,6 @@ double scaled_logit(double logit_p, double log_c) {
   return log_p - log_one_minus_p;
 }
 
-// Mip-Splatting's 3D filter folded into the scales and opacity, in log space: log of
-// sqrt(s^2 + f^2) is half of log_add_exp(2 log s, 2 log f).
-SplatCloud bake_filter_3d(SplatCloud cloud) {
-  for (size_t i = 0; i < cloud.filter_3d.size(); ++i) {
-    const double log_filter = std::log(std::fabs(double(cloud.filter_3d[i])));
-    double log_opacity_factor = 0;
-    for (size_t k = 0; k < 3; ++k) {
-      float& log_scale = cloud.log_scales[3 * i + k];
-      const double widened = 0.5 * log_add_exp(2.0 * log_scale, 2.0 * log_filter);
-      log_opacity_factor += log_scale - widened;
-      log_scale = float(widened);
-    }
-    cloud.opacity[i] = float(scaled_logit(cloud.opacity[i], log_opacity_factor));
-  }
-  cloud.filter_3d.clear();
-  return cloud;
-}
-
 // ---- reading ----
 
 enum class Scalar { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
@@ -446,8 +428,29 @@ void write_ply(const fs::path& path, const SplatCloud& cloud) {
   });
 }
 
+void check_splat_cloud(const SplatCloud& cloud, const fs::path& path) {
+  checked_layout(cloud, path);
+}
+
+// In log space: log of sqrt(s^2 + f^2) is half of log_add_exp(2 log s, 2 log f).
+SplatCloud bake_filter_3d(SplatCloud cloud) {
+  for (size_t i = 0; i < cloud.filter_3d.size(); ++i) {
+    const double log_filter = std::log(std::fabs(double(cloud.filter_3d[i])));
+    double log_opacity_factor = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      float& log_scale = cloud.log_scales[3 * i + k];
+      const double widened = 0.5 * log_add_exp(2.0 * log_scale, 2.0 * log_filter);
+      log_opacity_factor += log_scale - widened;
+      log_scale = float(widened);
+    }
+    cloud.opacity[i] = float(scaled_logit(cloud.opacity[i], log_opacity_factor));
+  }
+  cloud.filter_3d.clear();
+  return cloud;
+}
+
 void write_ply_filter_baked(const fs::path& path, const SplatCloud& cloud) {
-  checked_layout(cloud, path);  // before baking indexes the arrays
+  check_splat_cloud(cloud, path);  // before baking indexes the arrays
   write_ply(path, bake_filter_3d(cloud));
 }
 

@@ -30,10 +30,16 @@ struct SplatCloud {
 // size or hold a non-finite value.
 void write_ply(const std::filesystem::path& path, const SplatCloud& cloud);
 
-// The same with the 3D filter folded into each Gaussian, as Mip-Splatting's "fused" export, so
-// that viewers without the filter render it correctly: scale sqrt(s^2 + f^2) and opacity
-// sigmoid(o) * sqrt(prod(s^2) / prod(s^2 + f^2)), stored as log and logit; no filter_3D property.
-// A cloud without the filter is written as write_ply writes it.
+// Throws Error naming `path` when the cloud's arrays disagree with its size and SH degree.
+void check_splat_cloud(const SplatCloud& cloud, const std::filesystem::path& path);
+
+// The 3D filter folded into each Gaussian, as Mip-Splatting's "fused" export, so that renderers
+// without the filter draw the same: scale sqrt(s^2 + f^2) and opacity
+// sigmoid(o) * sqrt(prod(s^2) / prod(s^2 + f^2)), stored as log and logit; no filter_3d left.
+// A cloud without the filter comes back unchanged. Expects a checked cloud.
+SplatCloud bake_filter_3d(SplatCloud cloud);
+
+// write_ply of the cloud with its 3D filter baked, for viewers that do not know the filter.
 void write_ply_filter_baked(const std::filesystem::path& path, const SplatCloud& cloud);
 
 // Reads ascii or binary_little_endian files with the properties in any order and any scalar type;

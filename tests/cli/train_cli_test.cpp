@@ -5,6 +5,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
+#include "io/ply.hpp"
 #include "support/cli_run.hpp"
 #include "support/temp_dir.hpp"
 
@@ -64,6 +65,16 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   for (const char* frame : {"path_0000", "path_0001", "path_0002"})
     EXPECT_EQ(read_image_header(dir / "orbit" / "rgb" / (std::string(frame) + ".png")).width, 32)
         << frame;
+
+  const auto splat = dir / "scene.splat";
+  const CliRun exported = iesrgs("export " + out + " " + splat.string());
+  ASSERT_EQ(exported.status, 0) << exported.output;
+  const size_t gaussians = read_ply(dir / "run" / "point_cloud.ply").size();
+  EXPECT_EQ(std::filesystem::file_size(splat), 32 * gaussians);
+  const CliRun unknown = iesrgs("export " + out + " " + (dir / "scene.obj").string());
+  EXPECT_EQ(unknown.status, 1);
+  EXPECT_TRUE(contains(last_line(unknown.output), "scene.obj: unknown export format"))
+      << unknown.output;
 }
 
 TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModel) {

@@ -1,0 +1,20 @@
+#pragma once
+// The compact .splat format of the web viewers (antimatter15's splat viewer and the many built on
+// it; gsplat and LichtFeld Studio export it too): 32 bytes per Gaussian, no header, colour
+// without view dependence.
+#include <filesystem>
+
+#include "io/ply.hpp"
+
+namespace iesrgs {
+
+constexpr size_t kSplatRecordBytes = 32;
+
+// Per Gaussian, little-endian: position (3 float32), scale (3 float32, activated), colour and
+// opacity (4 uint8: 0.5 + C0 * f_dc and sigmoid(opacity), times 255) and the normalized rotation
+// quaternion w x y z (4 uint8: q * 128 + 128), the most visible Gaussians first (largest
+// prod(scale) * opacity), as the viewers stream them. Mip-Splatting's 3D filter is baked in
+// first. Written atomically; throws Error naming the file for a malformed or non-finite cloud.
+void write_splat(const std::filesystem::path& path, const SplatCloud& cloud);
+
+}  // namespace iesrgs
