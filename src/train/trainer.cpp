@@ -16,6 +16,7 @@
 #include "eval/metrics.hpp"
 #include "gs/checkpoint.hpp"
 #include "gs/densify.hpp"
+#include "io/cameras_json.hpp"
 #include "loss/autograd.hpp"
 #include "raster/rasterizer.hpp"
 #include "train/progress.hpp"
@@ -223,6 +224,9 @@ TrainSummary Trainer::run() {
   InterruptScope interrupt_scope;
   TrainSummary summary;
   ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations);
+  std::vector<Camera> cameras;
+  for (const TrainView& view : setup_.train_views) cameras.push_back(view.camera);
+  write_cameras_json(setup_.output_dir / "cameras.json", cameras);
   const auto start = std::chrono::steady_clock::now();
   const int64_t first = iteration_;
   double loss = 0;

@@ -32,7 +32,7 @@ struct TrainerSetup {
   std::vector<TrainView> test_views;  // for the periodic PSNR report; may be empty
   std::array<float, 3> background{1, 1, 1};
   double scene_extent = 1;
-  std::filesystem::path output_dir;  // checkpoint.pt and train_log.csv go here
+  std::filesystem::path output_dir;  // checkpoint.pt, train_log.csv, cameras.json go here
   ViewLoss loss;                     // empty: the photometric default
 };
 

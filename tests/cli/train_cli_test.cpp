@@ -29,7 +29,7 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   ASSERT_EQ(train.status, 0) << train.output;
   EXPECT_TRUE(contains(train.output, "it/s")) << train.output;
   for (const char* file : {"point_cloud.ply", "point_cloud_filter_baked.ply", "config.json",
-                           "training.json", "train_log.csv", "checkpoint.pt"})
+                           "training.json", "train_log.csv", "checkpoint.pt", "cameras.json"})
     EXPECT_TRUE(std::filesystem::exists(dir / "run" / file)) << file;
   const auto config = nlohmann::json::parse(read_file(dir / "run" / "config.json"));
   EXPECT_EQ(config["views_per_iteration"], 2);
