@@ -31,12 +31,6 @@ double elapsed_ms(std::chrono::steady_clock::time_point since) {
       .count();
 }
 
-// Median over iterations of each stage, so one disturbed run (a shared machine) does not skew it.
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 void run_raster_bench(const RasterBenchArgs& args) {
   if (args.gaussians < 0 || args.width <= 0 || args.height <= 0 || args.iterations <= 0 ||
       args.threads < 0)
@@ -86,6 +80,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
       n, drawn, args.width, args.height, frame.bins.entry_count(), omp_get_max_threads(),
       args.iterations);
   fmt::print("blend kernels: {}\n", cpu::describe_isa(cpu::active_isa()));
+  // Medians over iterations, so one disturbed run (a shared machine) does not skew a stage.
   fmt::print("forward: {:.1f} ms\n", median(forward));
   fmt::print("forward+backward: {:.1f} ms\n", median(total));
   fmt::print("  projection: {:.1f} ms\n", median(project));

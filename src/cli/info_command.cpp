@@ -1,10 +1,14 @@
-// iesrgs info: what a scene holds, and with --load-images whether every image decodes.
+// iesrgs info: what a scene holds, and with --load-images whether every image decodes; or what
+// a trained model (.ply) holds.
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
+#include "io/ply.hpp"
 #include "io/view_images.hpp"
 
 namespace iesrgs::cli {
@@ -38,6 +42,32 @@ void print_summary(const Scene& scene) {
              scene.background[2]);
 }
 
+void print_model_summary(const std::filesystem::path& path) {
+  const SplatCloud cloud = read_ply(path);
+  const size_t n = cloud.size();
+  fmt::print("model       {}\n", path.string());
+  fmt::print("gaussians   {}\n", n);
+  fmt::print("sh degree   {}\n", cloud.sh_degree);
+  fmt::print("3D filter   {}\n", cloud.has_filter_3d() ? "yes (Mip-Splatting)" : "no");
+  if (n == 0) return;
+  Vec3 low{INFINITY, INFINITY, INFINITY}, high = -low;
+  std::vector<double> opacity(n), largest_scale(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = &cloud.positions[3 * i];
+    low = {std::min(low.x, double(p[0])), std::min(low.y, double(p[1])),
+           std::min(low.z, double(p[2]))};
+    high = {std::max(high.x, double(p[0])), std::max(high.y, double(p[1])),
+            std::max(high.z, double(p[2]))};
+    opacity[i] = 1 / (1 + std::exp(-double(cloud.opacity[i])));
+    const float* s = &cloud.log_scales[3 * i];
+    largest_scale[i] = std::exp(double(std::max({s[0], s[1], s[2]})));
+  }
+  fmt::print("bounds      ({:.3f}, {:.3f}, {:.3f}) to ({:.3f}, {:.3f}, {:.3f})\n", low.x, low.y,
+             low.z, high.x, high.y, high.z);
+  fmt::print("opacity     median {:.3f}\n", median(opacity));
+  fmt::print("scale       median largest axis {:.4g}\n", median(largest_scale));
+}
+
 // Decodes every image in order and stops at the first bad one (the Error names it).
 void load_every_image(const Scene& scene) {
   ViewImageOptions options;
@@ -58,7 +88,9 @@ void load_every_image(const Scene& scene) {
 
 void add_info_command(CLI::App& app) {
   auto* command =
-      app.add_subcommand("info", "Print a scene's cameras, image size, splits, points and extent");
+      app.add_subcommand("info",
+                         "Print a scene's cameras, image size, splits, points and extent, or a "
+                         "trained model's (.ply) Gaussians");
   auto args = std::make_shared<SceneArgs>();
   auto load_images = std::make_shared<bool>(false);
   args->add_to(*command);
@@ -66,6 +98,10 @@ void add_info_command(CLI::App& app) {
                     "Also decode every image (undistorted and resized as training would) and "
                     "fail on the first bad one");
   command->callback([args, load_images] {
+    if (std::filesystem::path(args->path).extension() == ".ply") {
+      print_model_summary(args->path);
+      return;
+    }
     const Scene scene = load_scene(args->path, args->resolved());
     print_summary(scene);
     if (*load_images) load_every_image(scene);

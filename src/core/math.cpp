@@ -1,6 +1,14 @@
 #include "core/math.hpp"
 
+#include <algorithm>
+
 namespace iesrgs {
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
 
 std::array<double, 4> rotation_to_quat(const Mat3& r) {
   const double trace = r(0, 0) + r(1, 1) + r(2, 2);

@@ -2,6 +2,7 @@
 // Small fixed-size vector and matrix types for camera geometry (double precision on the host).
 #include <array>
 #include <cmath>
+#include <vector>
 
 namespace iesrgs {
 
@@ -53,6 +54,9 @@ struct Mat3 {
     return r;
   }
 };
+
+// The middle value (the upper one of the two middle values for an even count); 0 when empty.
+double median(std::vector<double> values);
 
 // Rotation matrix from a unit quaternion (w, x, y, z), as COLMAP stores it.
 inline Mat3 quat_to_rotation(double w, double x, double y, double z) {

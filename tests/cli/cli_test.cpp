@@ -8,6 +8,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
+#include "io/ply.hpp"
 #include "support/cli_run.hpp"
 #include "support/temp_dir.hpp"
 
@@ -87,6 +88,23 @@ TEST(Cli, UpscaleOfAMissingInputNamesIt) {
   EXPECT_EQ(run.status, 1);
   EXPECT_EQ(last_line(run.output),
             "error: " + (dir / "nothing.png").string() + ": no such image or folder");
+}
+
+TEST(Cli, InfoOfAModelSummarizesItsGaussians) {
+  TempDir dir;
+  SplatCloud cloud;
+  cloud.positions = {-1, 0, 2, 3, -4, 5};
+  cloud.sh_dc = {0, 0, 0, 0, 0, 0};
+  cloud.opacity = {0, 0};
+  cloud.log_scales = {0, -1, -2, 0, 0, 0};
+  cloud.rotations = {1, 0, 0, 0, 1, 0, 0, 0};
+  write_ply(dir / "model.ply", cloud);
+  const CliRun run = iesrgs("info " + (dir / "model.ply").string());
+  EXPECT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(contains(run.output, "gaussians   2\nsh degree   0\n3D filter   no")) << run.output;
+  EXPECT_TRUE(contains(run.output, "(-1.000, -4.000, 2.000) to (3.000, 0.000, 5.000)"))
+      << run.output;
+  EXPECT_TRUE(contains(run.output, "opacity     median 0.500")) << run.output;
 }
 
 TEST(Cli, EvalCompositesRgbaRendersOverTheBackground) {
