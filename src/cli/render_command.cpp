@@ -1,6 +1,6 @@
 // iesrgs render: a trained model seen from a scene's cameras, at any resolution factor
 // (--scale 4 renders four times the cameras' resolution with the same field of view), or along a
-// fly-around path fitted to the training cameras (--path orbit).
+// camera path made from the training cameras (--path orbit | interp).
 #include <fmt/core.h>
 
 #include <nlohmann/json.hpp>
@@ -39,7 +39,8 @@ void run_render(const RenderArgs& args) {
   } else {
     const std::vector<const Camera*> train = scene.split(Split::Train);
     if (train.empty()) fail_file(scene.root, "has no training views to fit a camera path to");
-    cameras = pipeline::orbit_path(train, args.frames);
+    cameras = args.path == "orbit" ? pipeline::orbit_path(train, args.frames)
+                                   : pipeline::interpolated_path(train, args.frames);
   }
   if (cameras.empty()) fail_file(scene.root, fmt::format("has no {} views", args.split));
   fmt::print("rendering {} {} views of {} Gaussians at x{}\n", cameras.size(), what, model.size(),
@@ -73,10 +74,11 @@ void add_render_command(CLI::App& app) {
       ->capture_default_str();
   command
       ->add_option("--path", args->path,
-                   "Render a fly-around instead of --split: an orbit fitted to the training "
-                   "cameras (or a sweep along the arc they cover), looking at the point they "
-                   "look at (frames path_0000.png, ...)")
-      ->check(CLI::IsMember({"orbit"}));
+                   "Render a camera path instead of --split (frames path_0000.png, ...): orbit, "
+                   "fitted to the training cameras (or a sweep along the arc they cover) and "
+                   "looking at the point they look at; interp, a smooth curve through the "
+                   "training cameras in order")
+      ->check(CLI::IsMember({"orbit", "interp"}));
   command->add_option("--frames", args->frames, "Frames of --path")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

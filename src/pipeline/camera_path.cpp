@@ -138,6 +138,45 @@ void look_at(Camera& camera, const Vec3& eye, const Vec3& target, const Vec3& up
   camera.translation = -(camera.rotation * eye);
 }
 
+// Catmull-Rom between p1 and p2 at t in [0, 1], with p0 and p3 the neighbours on either side: a
+// curve through every key position with a continuous tangent.
+Vec3 catmull_rom(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3, double t) {
+  const double t2 = t * t, t3 = t2 * t;
+  return (p1 * 2 + (p2 - p0) * t + (p0 * 2 - p1 * 5 + p2 * 4 - p3) * t2 +
+          (p1 * 3 - p0 - p2 * 3 + p3) * t3) *
+         0.5;
+}
+
+// Spherical interpolation of unit quaternions (w, x, y, z), along the shorter arc.
+std::array<double, 4> slerp(std::array<double, 4> a, const std::array<double, 4>& b, double t) {
+  double cosine = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+  if (cosine < 0) {
+    for (double& v : a) v = -v;
+    cosine = -cosine;
+  }
+  double wa = 1 - t, wb = t;  // nearly equal rotations: linear is exact enough and stable
+  if (cosine < 0.9995) {
+    const double angle = std::acos(cosine);
+    wa = std::sin((1 - t) * angle) / std::sin(angle);
+    wb = std::sin(t * angle) / std::sin(angle);
+  }
+  std::array<double, 4> q;
+  double norm = 0;
+  for (int k = 0; k < 4; ++k) {
+    q[k] = wa * a[k] + wb * b[k];
+    norm += q[k] * q[k];
+  }
+  for (double& v : q) v /= std::sqrt(norm);
+  return q;
+}
+
+Camera path_camera(const Camera& intrinsics_from, int index) {
+  Camera camera = intrinsics_from;
+  camera.name = fmt::format("path_{:04d}", index);
+  camera.image_path.clear();
+  return camera;
+}
+
 }  // namespace
 
 Vec3 focus_point(const std::vector<const Camera*>& cameras) {
@@ -155,8 +194,10 @@ Vec3 focus_point(const std::vector<const Camera*>& cameras) {
   }
   // Parallel optical axes (one camera, or a rig of parallel cameras) meet nowhere.
   if (std::abs(determinant(a)) < 1e-6 * std::pow(double(cameras.size()), 3))
-    fail("the {} training cameras look in parallel directions: no point to circle around",
-         cameras.size());
+    fail(
+        "the {} training cameras look in parallel directions: no point to circle around (an "
+        "interpolated path follows the cameras instead)",
+        cameras.size());
   return solve(a, b);
 }
 
@@ -177,10 +218,31 @@ std::vector<Camera> orbit_path(const std::vector<const Camera*>& cameras, int fr
       const double t = arc.start + arc.span * (1 - std::cos(phase)) / 2;
       around = (ring.major * std::cos(t) + ring.minor * std::sin(t)) * ring.mean_radius;
     }
-    Camera camera = *cameras.front();
-    camera.name = fmt::format("path_{:04d}", k);
-    camera.image_path.clear();
+    Camera camera = path_camera(*cameras.front(), k);
     look_at(camera, ring.focus + around + ring.up * ring.height, ring.focus, ring.up);
+    path.push_back(camera);
+  }
+  return path;
+}
+
+std::vector<Camera> interpolated_path(const std::vector<const Camera*>& cameras, int frames) {
+  if (cameras.empty()) fail("a camera path needs at least one training camera");
+  if (frames < 1) fail("a camera path needs at least one frame, got {}", frames);
+  const int last = int(cameras.size()) - 1;
+  auto center = [&](int i) { return cameras[std::clamp(i, 0, last)]->center(); };
+  std::vector<Camera> path;
+  for (int k = 0; k < frames; ++k) {
+    // Frame k sits at u along the keys: the first frame on the first camera, the last on the last.
+    const double u = frames > 1 ? double(k) * last / (frames - 1) : 0;
+    const int i = std::min(int(u), std::max(last - 1, 0));
+    const double t = std::min(u - i, 1.0);
+    const int next = std::min(i + 1, last);
+    const Vec3 eye = catmull_rom(center(i - 1), center(i), center(i + 1), center(i + 2), t);
+    const std::array<double, 4> q =
+        slerp(rotation_to_quat(cameras[i]->rotation), rotation_to_quat(cameras[next]->rotation), t);
+    Camera camera = path_camera(*cameras.front(), k);
+    camera.rotation = quat_to_rotation(q[0], q[1], q[2], q[3]);
+    camera.translation = -(camera.rotation * eye);
     path.push_back(camera);
   }
   return path;

@@ -19,4 +19,11 @@ Vec3 focus_point(const std::vector<const Camera*>& cameras);
 // back. They have the first camera's intrinsics and are named path_0000, path_0001, ...
 std::vector<Camera> orbit_path(const std::vector<const Camera*>& cameras, int frames);
 
+// `frames` cameras along a smooth curve through the cameras in their given order (the capture's
+// order when the images are numbered), as gsplat's and nerfstudio's interpolated paths: positions
+// on a Catmull-Rom spline through the camera centres, rotations slerped between neighbours, the
+// first and the last frame on the first and the last camera. For any capture, forward-facing
+// ones included; first camera's intrinsics, named like orbit_path's.
+std::vector<Camera> interpolated_path(const std::vector<const Camera*>& cameras, int frames);
+
 }  // namespace iesrgs::pipeline

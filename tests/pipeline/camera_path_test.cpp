@@ -119,5 +119,36 @@ TEST(CameraPath, ParallelCamerasAreAClearError) {
   EXPECT_TRUE(testing::contains(message, "look in parallel directions")) << message;
 }
 
+TEST(CameraPath, InterpolatedPathPassesThroughEveryCameraInOrder) {
+  const std::vector<Camera> cameras = {camera_at({3, 0, 1}, {0, 0, 0}),
+                                       camera_at({0, 3, 1.5}, {0, 0, 0}),
+                                       camera_at({-3, 0, 1}, {0, 0, 0})};
+  const std::vector<Camera> path = interpolated_path(pointers(cameras), 5);  // 2 frames per gap
+  ASSERT_EQ(path.size(), 5u);
+  for (int key = 0; key < 3; ++key) {
+    const Camera& frame = path[2 * key];
+    EXPECT_NEAR((frame.center() - cameras[key].center()).norm(), 0, 1e-9) << key;
+    for (int k = 0; k < 9; ++k)
+      EXPECT_NEAR(frame.rotation.m[k], cameras[key].rotation.m[k], 1e-9) << key;
+  }
+  EXPECT_EQ(path[4].name, "path_0004");
+}
+
+TEST(CameraPath, InterpolatedPathSlerpsHalfwayBetweenTwoCameras) {
+  // Two cameras 90 degrees apart around the target: halfway looks from 45 degrees.
+  const std::vector<Camera> cameras = {camera_at({2, 0, 0}, {0, 0, 0}),
+                                       camera_at({4, 2, 0}, {4, 0, 0})};
+  const Camera middle = interpolated_path(pointers(cameras), 3)[1];
+  EXPECT_NEAR((middle.center() - Vec3{3, 1, 0}).norm(), 0, 1e-9);  // straight between two keys
+  const Vec3 forward{middle.rotation(2, 0), middle.rotation(2, 1), middle.rotation(2, 2)};
+  EXPECT_NEAR(forward.dot(normalized(Vec3{-1, -1, 0})), 1, 1e-9);
+}
+
+TEST(CameraPath, InterpolatedPathOfOneCameraStaysOnIt) {
+  const std::vector<Camera> cameras = {camera_at({1, 2, 3}, {0, 0, 0})};
+  for (const Camera& frame : interpolated_path(pointers(cameras), 4))
+    EXPECT_NEAR((frame.center() - cameras[0].center()).norm(), 0, 1e-9);
+}
+
 }  // namespace
 }  // namespace iesrgs::pipeline
