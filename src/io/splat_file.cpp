@@ -36,22 +36,34 @@ std::vector<size_t> most_visible_first(const SplatCloud& cloud) {
   return order;
 }
 
-void append_record(std::string& bytes, const SplatCloud& cloud, size_t i,
-                   const std::filesystem::path& path) {
+double quaternion_norm(const float* q) {
+  return std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] +
+                   double(q[3]) * q[3]);
+}
+
+// Before sorting, which needs finite keys; a scale must stay finite once exponentiated.
+void check_finite(const SplatCloud& cloud, const std::filesystem::path& path) {
+  auto finite = [](const std::vector<float>& values, size_t from, bool exponentiated) {
+    return std::all_of(values.begin() + from, values.begin() + from + 3,
+                       [&](float v) { return std::isfinite(exponentiated ? std::exp(v) : v); });
+  };
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const double norm = quaternion_norm(&cloud.rotations[4 * i]);
+    if (!finite(cloud.positions, 3 * i, false) || !finite(cloud.log_scales, 3 * i, true) ||
+        !finite(cloud.sh_dc, 3 * i, false) || !std::isfinite(cloud.opacity[i]) ||
+        !std::isfinite(norm) || norm == 0)
+      fail_file(path, fmt::format("Gaussian {} has a non-finite or degenerate parameter", i));
+  }
+}
+
+void append_record(std::string& bytes, const SplatCloud& cloud, size_t i) {
   float floats[6];
   for (int k = 0; k < 3; ++k) {
     floats[k] = cloud.positions[3 * i + k];
     floats[3 + k] = std::exp(cloud.log_scales[3 * i + k]);
   }
   const float* q = &cloud.rotations[4 * i];
-  const double norm = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] +
-                                double(q[3]) * q[3]);
-  const bool finite = std::all_of(floats, floats + 6, [](float v) { return std::isfinite(v); }) &&
-                      std::isfinite(cloud.opacity[i]) && std::isfinite(norm) && norm > 0 &&
-                      std::all_of(&cloud.sh_dc[3 * i], &cloud.sh_dc[3 * i] + 3,
-                                  [](float v) { return std::isfinite(v); });
-  if (!finite)
-    fail_file(path, fmt::format("Gaussian {} has a non-finite or degenerate parameter", i));
+  const double norm = quaternion_norm(q);
   uint8_t tail[8];
   for (int k = 0; k < 3; ++k) tail[k] = to_byte((0.5 + kShC0 * cloud.sh_dc[3 * i + k]) * 255);
   tail[3] = to_byte(sigmoid(cloud.opacity[i]) * 255);
@@ -70,7 +82,8 @@ void write_splat(const std::filesystem::path& path, const SplatCloud& cloud) {
   const SplatCloud baked = bake_filter_3d(cloud);
   std::string bytes;
   bytes.reserve(baked.size() * kSplatRecordBytes);
-  for (size_t i : most_visible_first(baked)) append_record(bytes, baked, i, path);
+  check_finite(baked, path);
+  for (size_t i : most_visible_first(baked)) append_record(bytes, baked, i);
   write_file_atomically(path, bytes);
 }
 

@@ -86,6 +86,15 @@ TEST(SplatFile, NonFiniteOrMalformedCloudsAreErrorsAndWriteNothing) {
   const std::string bad = error_message([&] { write_splat(dir / "a.splat", cloud); });
   EXPECT_TRUE(contains(bad, "a.splat: Gaussian 1 has a non-finite")) << bad;
   cloud = two_gaussians();
+  cloud.log_scales[0] = 100;  // finite, but not once exponentiated into a float
+  const std::string huge = error_message([&] { write_splat(dir / "a.splat", cloud); });
+  EXPECT_TRUE(contains(huge, "a.splat: Gaussian 0 has a non-finite")) << huge;
+  cloud = two_gaussians();
+  cloud.positions[0] = 1e30f;  // far, but a valid position
+  write_splat(dir / "far.splat", cloud);
+  EXPECT_EQ(decode(read_file(dir / "far.splat"))[1].position[0], 1e30f);
+  std::filesystem::remove(dir / "far.splat");
+  cloud = two_gaussians();
   cloud.opacity.pop_back();
   const std::string short_array = error_message([&] { write_splat(dir / "b.splat", cloud); });
   EXPECT_TRUE(contains(short_array, "b.splat: the array of 'opacity' holds 1 values"))
