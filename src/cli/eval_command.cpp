@@ -7,6 +7,7 @@
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "eval/lpips.hpp"
 #include "eval/metrics.hpp"
 #include "io/view_images.hpp"
@@ -26,12 +27,6 @@ struct EvalArgs {
   std::string lpips = "alex";
 };
 
-bool is_image(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
-}
-
 // Render files by stem, sorted; a render folder with an rgb/ subfolder (iesrgs render's layout)
 // is read from there.
 std::vector<std::filesystem::path> render_files(std::filesystem::path dir) {
@@ -39,7 +34,7 @@ std::vector<std::filesystem::path> render_files(std::filesystem::path dir) {
   if (!std::filesystem::is_directory(dir)) fail_file(dir, "is not a folder of rendered images");
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir))
-    if (entry.is_regular_file() && is_image(entry.path())) files.push_back(entry.path());
+    if (entry.is_regular_file() && is_image_file(entry.path())) files.push_back(entry.path());
   std::sort(files.begin(), files.end());
   if (files.empty()) fail_file(dir, "holds no PNG or JPEG images");
   return files;

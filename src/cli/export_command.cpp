@@ -4,6 +4,7 @@
 
 #include "cli/commands.hpp"
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "io/ply.hpp"
 #include "io/splat_file.hpp"
 
@@ -18,7 +19,7 @@ struct ExportArgs {
 
 void run_export(const ExportArgs& args) {
   const std::filesystem::path output = args.output;
-  const std::string format = output.extension().string();
+  const std::string format = lowercase_extension(output);
   if (format != ".splat" && format != ".ply")
     fail_file(output, "unknown export format: the name must end in .splat or .ply");
   const SplatCloud cloud = read_ply(model_ply(args.model));

@@ -8,6 +8,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
+#include "core/paths.hpp"
 #include "io/ply.hpp"
 #include "io/view_images.hpp"
 
@@ -98,7 +99,7 @@ void add_info_command(CLI::App& app) {
                     "Also decode every image (undistorted and resized as training would) and "
                     "fail on the first bad one");
   command->callback([args, load_images] {
-    if (std::filesystem::path(args->path).extension() == ".ply") {
+    if (lowercase_extension(args->path) == ".ply") {
       print_model_summary(args->path);
       return;
     }

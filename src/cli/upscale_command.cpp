@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "priors/sr/registry.hpp"
@@ -38,13 +39,6 @@ struct UpscaleArgs {
 struct Job {
   fs::path input, output;
 };
-
-bool is_image_file(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
-}
 
 // Every PNG / JPEG of `folder`, in name order, to a PNG of the same stem in `out`.
 std::vector<Job> folder_jobs(const fs::path& folder, const fs::path& out) {

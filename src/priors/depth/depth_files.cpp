@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "io/image.hpp"
 #include "io/npy.hpp"
 #include "priors/depth/depth_preview.hpp"
@@ -16,13 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool is_image(const fs::path& path) {
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return extension == ".png" || extension == ".jpg" || extension == ".jpeg";
-}
-
 fs::path preview_path(fs::path npy) {
   return npy.replace_filename(npy.stem().string() + "_preview.png");
 }
@@ -30,7 +24,7 @@ fs::path preview_path(fs::path npy) {
 std::vector<fs::path> images_in(const fs::path& folder) {
   std::vector<fs::path> images;
   for (const fs::directory_entry& entry : fs::directory_iterator(folder))
-    if (entry.is_regular_file() && is_image(entry.path())) images.push_back(entry.path());
+    if (entry.is_regular_file() && is_image_file(entry.path())) images.push_back(entry.path());
   if (images.empty()) fail_file(folder, "no PNG or JPEG images in this folder");
   std::sort(images.begin(), images.end());
   return images;

@@ -1,0 +1,24 @@
+#pragma once
+// File name helpers shared by the commands and readers.
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <string>
+
+namespace iesrgs {
+
+// ".png" for "a.PNG": file types are told apart by extension in any case.
+inline std::string lowercase_extension(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return extension;
+}
+
+// PNG or JPEG by name, the images every reader here decodes.
+inline bool is_image_file(const std::filesystem::path& path) {
+  const std::string extension = lowercase_extension(path);
+  return extension == ".png" || extension == ".jpg" || extension == ".jpeg";
+}
+
+}  // namespace iesrgs
