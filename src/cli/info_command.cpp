@@ -59,7 +59,7 @@ void print_model_summary(const std::filesystem::path& path) {
            std::min(low.z, double(p[2]))};
     high = {std::max(high.x, double(p[0])), std::max(high.y, double(p[1])),
             std::max(high.z, double(p[2]))};
-    opacity[i] = 1 / (1 + std::exp(-double(cloud.opacity[i])));
+    opacity[i] = sigmoid(cloud.opacity[i]);
     const float* s = &cloud.log_scales[3 * i];
     largest_scale[i] = std::exp(double(std::max({s[0], s[1], s[2]})));
   }

@@ -25,6 +25,10 @@ struct Vec3 {
   double norm() const { return std::sqrt(dot(*this)); }
 };
 
+inline double sigmoid(double x) {
+  return 1 / (1 + std::exp(-x));
+}
+
 inline Vec3 normalized(const Vec3& v) {
   return v * (1 / v.norm());
 }

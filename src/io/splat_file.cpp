@@ -20,10 +20,6 @@ uint8_t to_byte(double value) {
   return uint8_t(std::clamp(std::lround(value), 0L, 255L));
 }
 
-double sigmoid(double x) {
-  return 1 / (1 + std::exp(-x));
-}
-
 // What a viewer streams first: the product of the scales times the opacity, in log space.
 std::vector<size_t> most_visible_first(const SplatCloud& cloud) {
   std::vector<double> key(cloud.size());
@@ -80,9 +76,9 @@ void write_splat(const std::filesystem::path& path, const SplatCloud& cloud) {
   static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, ".splat floats are little-endian");
   check_splat_cloud(cloud, path);
   const SplatCloud baked = bake_filter_3d(cloud);
+  check_finite(baked, path);
   std::string bytes;
   bytes.reserve(baked.size() * kSplatRecordBytes);
-  check_finite(baked, path);
   for (size_t i : most_visible_first(baked)) append_record(bytes, baked, i);
   write_file_atomically(path, bytes);
 }

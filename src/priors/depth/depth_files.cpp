@@ -1,7 +1,6 @@
 #include "priors/depth/depth_files.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <set>
 #include <string>
 
