@@ -162,15 +162,18 @@ DensifyCounts densify_and_prune(GaussianModel& model, GaussianOptimizer& optimiz
 
 void reset_opacity(GaussianModel& model, GaussianOptimizer& optimizer) {
   torch::NoGradGuard no_grad;
-  const Tensor opacity = torch::sigmoid(model.opacity_logits.detach());
-  Tensor filter_gain = torch::ones_like(opacity);
+  // Mip-Splatting caps the opacity the renderer draws, opacity times the 3D filter's gain
+  // sqrt(prod(s^2 / (s^2 + f^2))), at 0.01: the stored opacity at min(opacity, 0.01 / gain). The
+  // gain is taken in log space because a Gaussian flattened far below its filter has a gain
+  // that underflows to 0 in floats, where 0.01 / gain would be NaN; its cap is then 1 - 1e-6.
+  const Tensor logits = model.opacity_logits.detach();
+  Tensor log_gain = torch::zeros_like(logits);
   if (model.filter_3d.defined()) {
-    const Tensor s2 = model.log_scales.detach().exp().square();
-    const Tensor f2 = model.filter_3d.square().unsqueeze(1);
-    filter_gain = torch::sqrt(s2.prod(1) / (s2 + f2).prod(1));
+    const Tensor log_ratio = 2 * (model.filter_3d.log().unsqueeze(1) - model.log_scales.detach());
+    log_gain = -0.5 * torch::softplus(log_ratio).sum(1);
   }
-  const Tensor capped = torch::clamp_max(opacity * filter_gain, 0.01) / filter_gain;
-  model.set_param(Param::OpacityLogits, torch::log(capped / (1 - capped)));
+  const Tensor cap = torch::logit((std::log(0.01) - log_gain).exp(), 1e-6);
+  model.set_param(Param::OpacityLogits, torch::minimum(logits, cap));
   optimizer.reset_moments(Param::OpacityLogits);
 }
 

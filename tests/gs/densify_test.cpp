@@ -173,5 +173,21 @@ TEST(Densify, OpacityResetCapsEffectiveOpacityAndZeroesItsMoments) {
   EXPECT_TRUE(m.opacity_logits.requires_grad());
 }
 
+// A Gaussian shrunk far below its 3D filter (scale 1e-13 per axis) has a gain that underflows
+// to 0 in floats; its cap 0.01 / gain must not become 0 / 0.
+TEST(Densify, OpacityResetOfGaussiansFlattenedBelowTheirFilterStaysFinite) {
+  GaussianModel m = tiny_model({1e-13f, 1e-13f, 0.05f}, {0.5f, 0.999f, 0.5f});
+  m.filter_3d = torch::tensor({0.05f, 0.05f, 0.05f});
+  const Tensor before = m.opacity_logits.detach().clone();
+  GaussianOptimizer opt = stepped_optimizer(m);
+  reset_opacity(m, opt);
+  EXPECT_TRUE(torch::isfinite(m.opacity_logits).all().item<bool>()) << m.opacity_logits;
+  // Drawn at opacity * gain, far below 0.01: the cap does not bind and nothing changes.
+  EXPECT_EQ(m.opacity_logits[0].item<float>(), before[0].item<float>());
+  EXPECT_EQ(m.opacity_logits[1].item<float>(), before[1].item<float>());
+  EXPECT_NEAR(torch::sigmoid(m.opacity_logits[2]).item<float>() / (2 * std::sqrt(2.f)), 0.01f,
+              1e-7);
+}
+
 }  // namespace
 }  // namespace iesrgs::gs
