@@ -1,0 +1,22 @@
+#pragma once
+// What the compact viewer formats (.splat, .spz) share: they have no field for Mip-Splatting's 3D
+// filter and store activated values, so a cloud is baked and checked before either is written.
+#include <cstdint>
+#include <filesystem>
+
+#include "io/ply.hpp"
+
+namespace iesrgs {
+
+// The cloud with its 3D filter baked in (bake_filter_3d). Throws Error naming `path` when the
+// arrays disagree in size, or when a Gaussian has a non-finite parameter, a scale that overflows
+// once exponentiated or a zero rotation.
+SplatCloud viewer_cloud(const SplatCloud& cloud, const std::filesystem::path& path);
+
+// Length of the quaternion at q[0..3].
+double quaternion_norm(const float* q);
+
+// The nearest integer in 0..255.
+uint8_t to_byte(double value);
+
+}  // namespace iesrgs
