@@ -1,5 +1,6 @@
-// iesrgs export: a trained model in the format a viewer wants: .splat for the web viewers, or a
-// .ply with Mip-Splatting's 3D filter baked in for any 3DGS viewer.
+// iesrgs export: a trained model in the format a viewer wants: .splat for the web viewers, .spz
+// (compressed, with the view-dependent colour), or a .ply with Mip-Splatting's 3D filter baked
+// in for any 3DGS viewer.
 #include <fmt/core.h>
 
 #include "cli/commands.hpp"
@@ -7,6 +8,7 @@
 #include "core/paths.hpp"
 #include "io/ply.hpp"
 #include "io/splat_file.hpp"
+#include "io/spz_file.hpp"
 
 namespace iesrgs::cli {
 
@@ -20,11 +22,13 @@ struct ExportArgs {
 void run_export(const ExportArgs& args) {
   const std::filesystem::path output = args.output;
   const std::string format = lowercase_extension(output);
-  if (format != ".splat" && format != ".ply")
-    fail_file(output, "unknown export format: the name must end in .splat or .ply");
+  if (format != ".splat" && format != ".spz" && format != ".ply")
+    fail_file(output, "unknown export format: the name must end in .splat, .spz or .ply");
   const SplatCloud cloud = read_ply(model_ply(args.model));
   if (format == ".splat")
     write_splat(output, cloud);
+  else if (format == ".spz")
+    write_spz(output, cloud);
   else
     write_ply_filter_baked(output, cloud);
   fmt::print("wrote {} Gaussians to {} ({} bytes)\n", cloud.size(), output.string(),
@@ -36,9 +40,10 @@ void run_export(const ExportArgs& args) {
 void add_export_command(CLI::App& app) {
   auto args = std::make_shared<ExportArgs>();
   CLI::App* command = app.add_subcommand(
-      "export", "Write a trained model as .splat (web viewers) or a filter-baked .ply");
+      "export",
+      "Write a trained model as .splat (web viewers), .spz (compressed) or a filter-baked .ply");
   command->add_option("model", args->model, "Training output folder or a 3DGS .ply")->required();
-  command->add_option("output", args->output, "OUT.splat or OUT.ply")->required();
+  command->add_option("output", args->output, "OUT.splat, OUT.spz or OUT.ply")->required();
   command->callback([args] { run_export(*args); });
 }
 

@@ -71,6 +71,10 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   ASSERT_EQ(exported.status, 0) << exported.output;
   const size_t gaussians = read_ply(dir / "run" / "point_cloud.ply").size();
   EXPECT_EQ(std::filesystem::file_size(splat), 32 * gaussians);
+  const auto spz = dir / "scene.spz";
+  const CliRun compressed = iesrgs("export " + out + " " + spz.string());
+  ASSERT_EQ(compressed.status, 0) << compressed.output;
+  EXPECT_EQ(read_file(spz).substr(0, 2), "\x1f\x8b");  // gzip
   const CliRun unknown = iesrgs("export " + out + " " + (dir / "scene.obj").string());
   EXPECT_EQ(unknown.status, 1);
   EXPECT_TRUE(contains(last_line(unknown.output), "scene.obj: unknown export format"))
