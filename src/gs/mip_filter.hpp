@@ -27,16 +27,18 @@ IESRGS_HD T filter3d(const T* scale, T filter_std, T* var) {
   return hd::sqrt(ratio);
 }
 
-// dscale = dL/dscale from dL/dvar and dL/dfactor.
+// dlog_scale = dL/d(log s) from dL/dvar and dL/dfactor. Taken with respect to the log scale,
+// which the model stores, it needs no division by s: a scale whose exp underflowed to 0 gets a
+// finite gradient.
 template <typename T>
 IESRGS_HD void filter3d_backward(const T* scale, T filter_std, const T* dvar, T dfactor,
-                                 T* dscale) {
+                                 T* dlog_scale) {
   T var[3];
   const T factor = filter3d(scale, filter_std, var);
   const T f2 = filter_std * filter_std;
-  // d log(factor) / d s_k = f^2 / (s_k (s_k^2 + f^2))
+  // d log(factor) / d log(s_k) = f^2 / (s_k^2 + f^2)
   for (int k = 0; k < 3; ++k)
-    dscale[k] = T(2) * scale[k] * dvar[k] + dfactor * factor * f2 / (scale[k] * var[k]);
+    dlog_scale[k] = T(2) * scale[k] * scale[k] * dvar[k] + dfactor * factor * f2 / var[k];
 }
 
 // Returns the opacity factor and writes the filtered covariance.

@@ -257,9 +257,10 @@ IESRGS_HD void project_backward(const GaussianParams<T>& g, int i, const RasterC
       for (int b = 0; b < 3; ++b) s += dsigma.m[a][b] * p.rot.m[b][k];
       drot.m[a][k] = T(2) * s * p.var[k];
     }
-  T dscale[3];
-  gs::filter3d_backward(p.scale, g.filter_std ? g.filter_std[i] : T(0), dvar, dopacity3d, dscale);
-  for (int k = 0; k < 3; ++k) grads.log_scales[3 * i + k] += dscale[k] * p.scale[k];
+  T dlog_scale[3];
+  gs::filter3d_backward(p.scale, g.filter_std ? g.filter_std[i] : T(0), dvar, dopacity3d,
+                        dlog_scale);
+  for (int k = 0; k < 3; ++k) grads.log_scales[3 * i + k] += dlog_scale[k];
   T dq[4];
   quat_to_rotation_backward(g.quats + 4 * i, drot, dq);
   for (int k = 0; k < 4; ++k) grads.quats[4 * i + k] += dq[k];
