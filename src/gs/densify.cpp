@@ -1,5 +1,7 @@
 #include "gs/densify.hpp"
 
+#include <cmath>
+
 #include "core/error.hpp"
 
 namespace iesrgs::gs {
@@ -55,11 +57,12 @@ NewRows split_children(const GaussianModel& model, const Tensor& mask) {
     rows.params[p] = parents.params[p].repeat(repeats);
   }
   if (parents.filter_3d.defined()) rows.filter_3d = parents.filter_3d.repeat({kSplitSamples});
-  const Tensor scales = rows.params[int(Param::LogScales)].exp();
-  const Tensor offsets = torch::randn_like(scales) * scales;
+  Tensor& log_scales = rows.params[int(Param::LogScales)];
+  const Tensor offsets = torch::randn_like(log_scales) * log_scales.exp();
   const Tensor rotations = rotation_matrices(rows.params[int(Param::Quats)]);
   rows.params[int(Param::Means)] += torch::bmm(rotations, offsets.unsqueeze(2)).squeeze(2);
-  rows.params[int(Param::LogScales)] = torch::log(scales / kSplitScaleDivisor);
+  // In log space: an axis whose exp underflows to 0 would otherwise get log(0).
+  log_scales = log_scales - std::log(kSplitScaleDivisor);
   return rows;
 }
 

@@ -128,6 +128,24 @@ TEST(Densify, SplitSamplesFollowTheRotatedShape) {
   EXPECT_NEAR(spread[2].item<float>(), 0.01f, 0.001f);
 }
 
+// A needle whose thin axis has shrunk until exp(log s) is 0 in floats still splits into children
+// with finite log scales, 1/1.6 of the parent's.
+TEST(Densify, SplitChildrenOfANeedleKeepFiniteLogScales) {
+  GaussianModel m = tiny_model({1.f}, {0.5f});
+  m.set_param(Param::LogScales, torch::tensor({{-120.f, 0.f, 0.f}}));
+  GaussianOptimizer opt(m, {}, kExtent);
+  DensifyStats stats = DensifyStats::zeros(1);
+  stats.accumulate({view({1.f}, {1})});
+  EXPECT_EQ(densify_and_prune(m, opt, stats, DensifyOptions{}, kExtent).split, 1);
+  ASSERT_EQ(m.size(), 2);
+  const float shrink = std::log(1.6f);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(m.log_scales[i][0].item<float>(), -120.f - shrink, 1e-4);
+    EXPECT_NEAR(m.log_scales[i][1].item<float>(), -shrink, 1e-6);
+  }
+  EXPECT_TRUE(torch::isfinite(m.means).all().item<bool>());
+}
+
 TEST(Densify, AbsoluteGradientsCanDriveDensification) {
   GaussianModel m = tiny_model({0.05f}, {0.5f});
   GaussianOptimizer opt(m, {}, kExtent);
