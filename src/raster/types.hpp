@@ -91,6 +91,12 @@ struct SplatGrad {
   T color[3];
   T depth;
   T abs_x, abs_y;
+
+  IESRGS_HD bool is_zero() const {
+    return x == T(0) && y == T(0) && conic_xx == T(0) && conic_xy == T(0) && conic_yy == T(0) &&
+           opacity == T(0) && color[0] == T(0) && color[1] == T(0) && color[2] == T(0) &&
+           depth == T(0) && abs_x == T(0) && abs_y == T(0);
+  }
 };
 
 // Half-open pixel rectangle [x0, x1) x [y0, y1) outside which a splat's alpha is below 1/255.

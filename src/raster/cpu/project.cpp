@@ -20,11 +20,15 @@ void project_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam, Spl
   }
 }
 
+// A Gaussian outside the view, or hidden behind others wherever it falls, has all-zero partials
+// and contributes nothing: skipping it saves recomputing its projection (most of the backward
+// pass on small images, where many Gaussians are hidden).
 template <typename T>
 void project_backward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
                       const SplatGrad<T>* splat_grads, const GaussianGrads<T>& grads) {
 #pragma omp parallel for schedule(static)
-  for (int i = 0; i < g.count; ++i) project_backward(g, i, cam, splat_grads[i], grads);
+  for (int i = 0; i < g.count; ++i)
+    if (!splat_grads[i].is_zero()) project_backward(g, i, cam, splat_grads[i], grads);
 }
 
 template void project_forward(const GaussianParams<float>&, const RasterCamera<float>&,
