@@ -21,7 +21,7 @@ struct TileBins {
   std::vector<uint64_t> gaussian_start;  // (N + 1)
   // Scratch reused between frames.
   std::vector<uint32_t> slot_gaussian, slot_tile;
-  std::vector<uint64_t> keys;
+  std::vector<uint64_t> keys, sort_scratch;
 
   int tile_count() const { return tiles_x * tiles_y; }
   size_t entry_count() const { return entry_gaussian.size(); }

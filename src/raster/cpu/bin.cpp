@@ -73,15 +73,46 @@ void group_by_tile(const Splat<T>* splats, TileBins& bins) {
   }
 }
 
+// Stable LSD radix sort of a tile's keys by their depth half, 8 bits per pass. group_by_tile
+// wrote them in slot order, so stability breaks depth ties by slot as a full-key sort would.
+// A pass whose digit is the same for every key is skipped: depths within a factor of two share
+// their top byte. Returns the buffer that holds the sorted keys.
+uint64_t* radix_sort_by_depth(uint64_t* keys, uint64_t* scratch, uint32_t n) {
+  constexpr int kPasses = 4;
+  uint32_t counts[kPasses][256] = {};
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t depth = uint32_t(keys[i] >> 32);
+    for (int p = 0; p < kPasses; ++p) ++counts[p][depth >> (8 * p) & 255];
+  }
+  uint64_t *src = keys, *dst = scratch;
+  for (int p = 0; p < kPasses; ++p) {
+    const int shift = 32 + 8 * p;
+    if (counts[p][src[0] >> shift & 255] == n) continue;
+    uint32_t offset[256], sum = 0;
+    for (int d = 0; d < 256; ++d) offset[d] = sum, sum += counts[p][d];
+    for (uint32_t i = 0; i < n; ++i) dst[offset[src[i] >> shift & 255]++] = src[i];
+    std::swap(src, dst);
+  }
+  return src;
+}
+
+// Below this many keys the histograms cost more than a comparison sort.
+constexpr uint32_t kRadixSortMinKeys = 256;
+
 void sort_tiles(TileBins& bins) {
   bins.entry_gaussian.resize(bins.keys.size());
   bins.entry_slot.resize(bins.keys.size());
+  bins.sort_scratch.resize(bins.keys.size());
 #pragma omp parallel for schedule(dynamic, 4)
   for (int t = 0; t < bins.tile_count(); ++t) {
     const uint32_t begin = bins.tile_start[t], end = bins.tile_start[t + 1];
-    std::sort(bins.keys.begin() + begin, bins.keys.begin() + end);
+    uint64_t* sorted = bins.keys.data() + begin;
+    if (end - begin >= kRadixSortMinKeys)
+      sorted = radix_sort_by_depth(sorted, bins.sort_scratch.data() + begin, end - begin);
+    else
+      std::sort(sorted, sorted + (end - begin));
     for (uint32_t e = begin; e < end; ++e) {
-      const uint32_t slot = uint32_t(bins.keys[e]);
+      const uint32_t slot = uint32_t(sorted[e - begin]);
       bins.entry_slot[e] = slot;
       bins.entry_gaussian[e] = bins.slot_gaussian[slot];
     }
