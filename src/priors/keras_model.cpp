@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "core/byte_reader.hpp"
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
-#include "priors/byte_reader.hpp"
 
 namespace iesrgs::priors::keras {
 

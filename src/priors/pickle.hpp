@@ -14,7 +14,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "priors/byte_reader.hpp"
+#include "core/byte_reader.hpp"
 
 namespace iesrgs::priors::pickle {
 

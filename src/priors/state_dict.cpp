@@ -6,9 +6,9 @@
 #include <cstring>
 #include <string_view>
 
+#include "core/byte_reader.hpp"
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
-#include "priors/byte_reader.hpp"
 #include "priors/pickle.hpp"
 #include "priors/zip_archive.hpp"
 

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "priors/byte_reader.hpp"
+#include "core/byte_reader.hpp"
 
 namespace iesrgs::priors {
 

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <type_traits>
 
-namespace iesrgs::priors {
+namespace iesrgs {
 
 class FormatError : public std::runtime_error {
  public:
@@ -55,4 +55,4 @@ class ByteReader {
   size_t position_;
 };
 
-}  // namespace iesrgs::priors
+}  // namespace iesrgs
