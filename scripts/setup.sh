@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
   build-essential cmake pkg-config
   libtorch-dev          # tensors, autograd, Adam, .pth checkpoints
-  libcli11-dev nlohmann-json3-dev libstb-dev libfmt-dev libspdlog-dev zlib1g-dev
+  libcli11-dev nlohmann-json3-dev libstb-dev libfmt-dev libspdlog-dev zlib1g-dev libzstd-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 # npm fetches the default super-resolution model (below); a Node.js install may already ship it.

@@ -6,6 +6,7 @@
 #include "cli/commands.hpp"
 #include "core/error.hpp"
 #include "core/paths.hpp"
+#include "io/model_file.hpp"
 #include "io/ply.hpp"
 #include "io/splat_file.hpp"
 #include "io/spz_file.hpp"
@@ -24,7 +25,7 @@ void run_export(const ExportArgs& args) {
   const std::string format = lowercase_extension(output);
   if (format != ".splat" && format != ".spz" && format != ".ply")
     fail_file(output, "unknown export format: the name must end in .splat, .spz or .ply");
-  const SplatCloud cloud = read_ply(model_ply(args.model));
+  const SplatCloud cloud = read_model(model_file(args.model));
   if (format == ".splat")
     write_splat(output, cloud);
   else if (format == ".spz")
@@ -42,7 +43,8 @@ void add_export_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "export",
       "Write a trained model as .splat (web viewers), .spz (compressed) or a filter-baked .ply");
-  command->add_option("model", args->model, "Training output folder or a 3DGS .ply")->required();
+  command->add_option("model", args->model, "Training output folder, a 3DGS .ply or an .spz")
+      ->required();
   command->add_option("output", args->output, "OUT.splat, OUT.spz or OUT.ply")->required();
   command->callback([args] { run_export(*args); });
 }

@@ -9,7 +9,7 @@
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
 #include "core/paths.hpp"
-#include "io/ply.hpp"
+#include "io/model_file.hpp"
 #include "io/view_images.hpp"
 
 namespace iesrgs::cli {
@@ -44,7 +44,7 @@ void print_summary(const Scene& scene) {
 }
 
 void print_model_summary(const std::filesystem::path& path) {
-  const SplatCloud cloud = read_ply(path);
+  const SplatCloud cloud = read_model(path);
   const size_t n = cloud.size();
   fmt::print("model       {}\n", path.string());
   fmt::print("gaussians   {}\n", n);
@@ -91,7 +91,7 @@ void add_info_command(CLI::App& app) {
   auto* command =
       app.add_subcommand("info",
                          "Print a scene's cameras, image size, splits, points and extent, or a "
-                         "trained model's (.ply) Gaussians");
+                         "trained model's (.ply, .spz) Gaussians");
   auto args = std::make_shared<SceneArgs>();
   auto load_images = std::make_shared<bool>(false);
   args->add_to(*command);
@@ -99,7 +99,7 @@ void add_info_command(CLI::App& app) {
                     "Also decode every image (undistorted and resized as training would) and "
                     "fail on the first bad one");
   command->callback([args, load_images] {
-    if (lowercase_extension(args->path) == ".ply") {
+    if (is_model_file(args->path)) {
       print_model_summary(args->path);
       return;
     }

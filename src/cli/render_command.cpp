@@ -10,7 +10,7 @@
 #include "core/error.hpp"
 #include "gs/model.hpp"
 #include "io/atomic_file.hpp"
-#include "io/ply.hpp"
+#include "io/model_file.hpp"
 #include "pipeline/camera_path.hpp"
 #include "pipeline/render_views.hpp"
 
@@ -29,7 +29,7 @@ struct RenderArgs {
 };
 
 void run_render(const RenderArgs& args) {
-  const gs::GaussianModel model = gs::model_from_splat_cloud(read_ply(model_ply(args.model)));
+  const gs::GaussianModel model = gs::model_from_splat_cloud(read_model(model_file(args.model)));
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   const std::string what = args.path.empty() ? args.split : args.path + " path";
   std::vector<Camera> cameras;
@@ -62,7 +62,8 @@ void run_render(const RenderArgs& args) {
 void add_render_command(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* command = app.add_subcommand("render", "Render a trained model from a scene's cameras");
-  command->add_option("model", args->model, "Training output folder or a 3DGS .ply")->required();
+  command->add_option("model", args->model, "Training output folder, a 3DGS .ply or an .spz")
+      ->required();
   args->scene.add_to(*command);
   command->add_option("-o,--output", args->output, "Output folder (rgb/, depth/, alpha/)")
       ->required();

@@ -29,6 +29,10 @@ inline double sigmoid(double x) {
   return 1 / (1 + std::exp(-x));
 }
 
+inline double logit(double p) {
+  return std::log(p / (1 - p));
+}
+
 inline Vec3 normalized(const Vec3& v) {
   return v * (1 / v.norm());
 }

@@ -1,12 +1,15 @@
 #include "io/spz_file.hpp"
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 #include <zlib.h>
+#include <zstd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
+#include "core/byte_reader.hpp"
 #include "core/error.hpp"
 #include "core/math.hpp"
 #include "io/atomic_file.hpp"
@@ -18,7 +21,13 @@ namespace {
 
 constexpr uint32_t kMagic = 0x5053474e;  // "NGSP" in file order
 constexpr uint32_t kVersion = 3;
+constexpr uint32_t kOldestReadVersion = 2;  // version 1 (float16 positions) was never released
+constexpr uint32_t kFirstZstdVersion = 4;   // a stream per attribute, each zstd-compressed
+constexpr uint32_t kNewestReadVersion = 4;
 constexpr uint8_t kAntialiased = 1;
+constexpr uint8_t kHasExtensions = 2;
+// No attribute stream compresses better than this; a larger claim is a corrupt file.
+constexpr uint64_t kMaxCompressionRatio = 1024;
 // The reference encoder's precision: 1/4096 of a unit. Fewer bits only where a Gaussian lies
 // beyond the 2048 units that 24 bits then reach.
 constexpr int kMaxFractionalBits = 12;
@@ -125,12 +134,203 @@ std::string gzip(const std::string& bytes, const std::filesystem::path& path) {
   return out;
 }
 
+// ---- Reading ----
+
+struct SpzHeader {
+  uint32_t version = 0, count = 0;
+  int sh_degree = 0, bits = 0;
+  uint8_t flags = 0;
+};
+
+// Uncompressed sizes of the attribute streams, in file order: positions, opacities, colours,
+// scales, rotations, higher SH bands.
+std::vector<uint64_t> stream_sizes(const SpzHeader& h) {
+  const uint64_t n = h.count, rest = 3 * (uint64_t(h.sh_degree + 1) * (h.sh_degree + 1) - 1);
+  return {9 * n, n, 3 * n, 3 * n, (h.version >= 3 ? 4 : 3) * n, rest * n};
+}
+
+uint64_t total_bytes(const std::vector<uint64_t>& sizes) {
+  uint64_t sum = 0;
+  for (uint64_t s : sizes) sum += s;
+  return sum;
+}
+
+// The part of the header every version shares, after magic and version.
+SpzHeader read_spz_header(ByteReader& in, uint32_t version) {
+  SpzHeader h;
+  h.version = version;
+  if (version < kOldestReadVersion || version > kNewestReadVersion)
+    throw FormatError(fmt::format("unsupported .spz version {} (versions {} to {} are read)",
+                                  version, kOldestReadVersion, kNewestReadVersion));
+  h.count = in.little<uint32_t>();
+  h.sh_degree = in.little<uint8_t>();
+  h.bits = in.little<uint8_t>();
+  h.flags = in.little<uint8_t>();
+  if (h.sh_degree > 3) throw FormatError(fmt::format("SH degree {} is above 3", h.sh_degree));
+  if (h.bits > 23) throw FormatError(fmt::format("{} fractional bits exceed 23", h.bits));
+  if (h.flags & kHasExtensions)
+    spdlog::warn(".spz extensions are not read; the Gaussians are decoded without them");
+  return h;
+}
+
+std::string gunzip(std::string_view compressed) {
+  z_stream stream{};
+  if (inflateInit2(&stream, 16 + MAX_WBITS) != Z_OK)
+    throw FormatError("zlib initialisation failed");
+  stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
+  stream.avail_in = uInt(compressed.size());
+  std::string out;
+  char buffer[1 << 16];
+  int status = Z_OK;
+  while (status == Z_OK && out.size() <= compressed.size() * kMaxCompressionRatio) {
+    stream.next_out = reinterpret_cast<Bytef*>(buffer);
+    stream.avail_out = sizeof buffer;
+    status = inflate(&stream, Z_NO_FLUSH);
+    out.append(buffer, sizeof buffer - stream.avail_out);
+  }
+  inflateEnd(&stream);
+  if (status != Z_STREAM_END) throw FormatError("corrupt or truncated gzip stream");
+  return out;
+}
+
+// Versions 2 and 3: one gzip stream of a 16-byte header and the attribute streams.
+std::string legacy_streams(std::string_view file, SpzHeader& h) {
+  const std::string bytes = gunzip(file);
+  ByteReader in(bytes);
+  if (in.little<uint32_t>() != kMagic) throw FormatError("not an .spz file (no NGSP header)");
+  const uint32_t version = in.little<uint32_t>();
+  if (version >= kFirstZstdVersion)
+    throw FormatError(fmt::format("version {} inside a gzip stream", version));
+  h = read_spz_header(in, version);
+  in.take(1);  // reserved
+  // Extensions, if any, follow the streams.
+  return std::string(in.take(total_bytes(stream_sizes(h))));
+}
+
+std::string unzstd(std::string_view compressed, uint64_t size) {
+  std::string out(size, '\0');
+  const size_t written = ZSTD_decompress(out.data(), size, compressed.data(), compressed.size());
+  if (ZSTD_isError(written) || written != size)
+    throw FormatError("corrupt zstd stream in the .spz file");
+  return out;
+}
+
+// Version 4: a 32-byte header, extensions, a table of (compressed, uncompressed) sizes, then one
+// zstd frame per non-empty attribute stream.
+std::string zstd_streams(std::string_view file, SpzHeader& h) {
+  ByteReader in(file);
+  in.take(4);  // magic
+  const uint32_t version = in.little<uint32_t>();
+  if (version < kFirstZstdVersion)
+    throw FormatError(fmt::format("version {} without its gzip stream", version));
+  h = read_spz_header(in, version);
+  const int stream_count = in.little<uint8_t>();
+  ByteReader table(file, in.little<uint32_t>());
+  std::vector<uint64_t> sizes = stream_sizes(h);
+  sizes.erase(std::remove(sizes.begin(), sizes.end(), 0), sizes.end());
+  if (stream_count != int(sizes.size()))
+    throw FormatError(fmt::format("{} attribute streams where {} Gaussians of SH degree {} need {}",
+                                  stream_count, h.count, h.sh_degree, sizes.size()));
+  std::vector<uint64_t> compressed(sizes.size());
+  for (size_t s = 0; s < sizes.size(); ++s) {
+    compressed[s] = table.little<uint64_t>();
+    if (table.little<uint64_t>() != sizes[s] ||
+        sizes[s] > (compressed[s] + 64) * kMaxCompressionRatio)
+      throw FormatError(
+          fmt::format("attribute stream {} has the wrong size for {} Gaussians", s, h.count));
+  }
+  std::string streams;
+  for (size_t s = 0; s < sizes.size(); ++s) streams += unzstd(table.take(compressed[s]), sizes[s]);
+  return streams;
+}
+
+float fixed_position(std::string_view bytes, size_t i, int bits) {
+  uint32_t fixed = 0;
+  for (int b = 0; b < 3; ++b) fixed |= uint32_t(uint8_t(bytes[3 * i + b])) << (8 * b);
+  if (fixed & 0x800000) fixed |= 0xff000000;  // sign extension
+  return float(std::ldexp(double(int32_t(fixed)), -bits));
+}
+
+// Inverse of smallest_three, to (w x y z).
+void unpack_smallest_three(uint32_t packed, float* wxyz) {
+  const int largest = int(packed >> 30);
+  double q[4], sum = 0;  // x y z w
+  for (int i = 3; i >= 0; --i) {
+    if (i == largest) continue;
+    const double magnitude = double(packed & 511) / 511 / std::sqrt(2.0);
+    q[i] = packed >> 9 & 1 ? -magnitude : magnitude;
+    sum += q[i] * q[i];
+    packed >>= 10;
+  }
+  q[largest] = std::sqrt(std::max(0.0, 1 - sum));
+  wxyz[0] = float(q[3]), wxyz[1] = float(q[0]), wxyz[2] = float(q[1]), wxyz[3] = float(q[2]);
+}
+
+// Version 2's rotations: x y z of the unit quaternion with w >= 0, one byte each.
+void unpack_first_three(const char* bytes, float* wxyz) {
+  double sum = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double v = uint8_t(bytes[k]) / 127.5 - 1;
+    wxyz[k + 1] = float(v);
+    sum += v * v;
+  }
+  wxyz[0] = float(std::sqrt(std::max(0.0, 1 - sum)));
+}
+
+SplatCloud decode_streams(const SpzHeader& h, const std::string& streams) {
+  const size_t n = h.count;
+  ByteReader in(streams);
+  SplatCloud cloud;
+  cloud.sh_degree = h.sh_degree;
+  const std::string_view positions = in.take(9 * n);
+  for (size_t i = 0; i < 3 * n; ++i)
+    cloud.positions.push_back(fixed_position(positions, i, h.bits));
+  // Opacity bytes 0 and 255 would be logits of -inf and +inf: half a step inside instead.
+  for (char c : in.take(n))
+    cloud.opacity.push_back(float(logit(std::clamp(double(uint8_t(c)), 0.5, 254.5) / 255)));
+  for (char c : in.take(3 * n))
+    cloud.sh_dc.push_back(float((uint8_t(c) / 255.0 - 0.5) / kColorScale));
+  for (char c : in.take(3 * n)) cloud.log_scales.push_back(float(uint8_t(c) / 16.0 - 10));
+  cloud.rotations.resize(4 * n);
+  const int rotation_bytes = h.version >= 3 ? 4 : 3;
+  const std::string_view rotations = in.take(rotation_bytes * n);
+  for (size_t i = 0; i < n; ++i) {
+    const char* r = rotations.data() + rotation_bytes * i;
+    if (rotation_bytes == 4)
+      unpack_smallest_three(ByteReader(std::string_view(r, 4)).little<uint32_t>(),
+                            &cloud.rotations[4 * i]);
+    else
+      unpack_first_three(r, &cloud.rotations[4 * i]);
+  }
+  for (char c : in.take(in.remaining())) cloud.sh_rest.push_back(float((uint8_t(c) - 128) / 128.0));
+  return cloud;
+}
+
 }  // namespace
 
 void write_spz(const std::filesystem::path& path, const SplatCloud& cloud) {
   const SplatCloud baked = viewer_cloud(cloud, path);
   const uint8_t flags = cloud.has_filter_3d() ? kAntialiased : 0;
   write_file_atomically(path, gzip(encode(baked, flags, fractional_bits(baked, path)), path));
+}
+
+SplatCloud parse_spz(std::string_view bytes, const std::filesystem::path& name) {
+  try {
+    SpzHeader header;
+    const bool gzipped =
+        bytes.size() >= 2 && uint8_t(bytes[0]) == 0x1f && uint8_t(bytes[1]) == 0x8b;
+    if (!gzipped && (bytes.size() < 4 || ByteReader(bytes).little<uint32_t>() != kMagic))
+      throw FormatError("not an .spz file (neither gzip nor an NGSP header)");
+    const std::string streams =
+        gzipped ? legacy_streams(bytes, header) : zstd_streams(bytes, header);
+    return decode_streams(header, streams);
+  } catch (const FormatError& e) {
+    fail_file(name, e.what());
+  }
+}
+
+SplatCloud read_spz(const std::filesystem::path& path) {
+  return parse_spz(read_file(path), path);
 }
 
 }  // namespace iesrgs

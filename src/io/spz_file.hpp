@@ -3,6 +3,7 @@
 // the viewers that read .spz (SuperSplat, Spark, Babylon.js and others) decode; about a tenth of
 // the .ply's size.
 #include <filesystem>
+#include <string_view>
 
 #include "io/ply.hpp"
 
@@ -16,5 +17,14 @@ namespace iesrgs {
 // and, when the cloud had one, the "antialiased" flag tells the viewer to use Mip-Splatting's 2D
 // filter. Written atomically; throws Error naming the file for a malformed or non-finite cloud.
 void write_spz(const std::filesystem::path& path, const SplatCloud& cloud);
+
+// Reads versions 2 and 3 (gzip) and 4 (one zstd stream per attribute) into raw 3DGS parameters:
+// logit opacities (bytes 0 and 255 half a quantization step inside (0, 1), where they would be
+// infinite), colours back to f_dc, unit quaternions. A written 3D filter stays baked in, so the
+// cloud has no filter_3d. Throws Error naming the file for anything it cannot decode.
+SplatCloud read_spz(const std::filesystem::path& path);
+
+// read_spz on bytes already in memory; `name` is only used in error messages.
+SplatCloud parse_spz(std::string_view bytes, const std::filesystem::path& name);
 
 }  // namespace iesrgs

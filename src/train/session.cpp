@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "io/image_tensor.hpp"
+#include "io/model_file.hpp"
 #include "io/ply.hpp"
 
 namespace iesrgs::train {
@@ -37,7 +38,7 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
                                 const std::filesystem::path& init_ply) {
   if (!init_ply.empty()) {
     spdlog::info("starting from {}", init_ply.string());
-    return gs::model_from_splat_cloud(read_ply(init_ply));
+    return gs::model_from_splat_cloud(read_model(init_ply));
   }
   if (config.init == "auto" && !scene.points.positions.empty()) {
     spdlog::info("starting from {} SfM points", scene.points.positions.size());

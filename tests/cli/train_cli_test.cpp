@@ -75,6 +75,22 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   const CliRun compressed = iesrgs("export " + out + " " + spz.string());
   ASSERT_EQ(compressed.status, 0) << compressed.output;
   EXPECT_EQ(read_file(spz).substr(0, 2), "\x1f\x8b");  // gzip
+  // The .spz is a model too: described, rendered and exported again like the .ply.
+  const CliRun described = iesrgs("info " + spz.string());
+  ASSERT_EQ(described.status, 0) << described.output;
+  EXPECT_TRUE(contains(described.output, fmt::format("gaussians   {}", gaussians)))
+      << described.output;
+  const CliRun rendered =
+      iesrgs("render " + spz.string() + " " + scene + " -o " + (dir / "from_spz").string());
+  ASSERT_EQ(rendered.status, 0) << rendered.output;
+  // Quantized to a byte or so per value, the model renders as the .ply does to a few levels.
+  const Image8 from_spz = read_image8(dir / "from_spz" / "rgb" / "r_0.png");
+  const Image8 from_ply = read_image8(dir / "same" / "rgb" / "r_0.png");
+  ASSERT_EQ(from_spz.data.size(), from_ply.data.size());
+  double difference = 0;
+  for (size_t i = 0; i < from_spz.data.size(); ++i)
+    difference += std::abs(int(from_spz.data[i]) - int(from_ply.data[i]));
+  EXPECT_LT(difference / double(from_spz.data.size()), 3.0);
   const CliRun unknown = iesrgs("export " + out + " " + (dir / "scene.obj").string());
   EXPECT_EQ(unknown.status, 1);
   EXPECT_TRUE(contains(last_line(unknown.output), "scene.obj: unknown export format"))

@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <string>
 
+#include "core/math.hpp"
 #include "io/atomic_file.hpp"
+#include "io/viewer_cloud.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -127,6 +129,98 @@ TEST(SpzFile, UnstorableCloudsAreErrorsAndWriteNothing) {
   const std::string far = error_message([&] { write_spz(dir / "a.spz", cloud); });
   EXPECT_TRUE(contains(far, "a.spz: a Gaussian lies 1e+07 units from the origin")) << far;
   EXPECT_FALSE(std::filesystem::exists(dir / "a.spz"));
+}
+
+void expect_values_near(const std::vector<float>& got, const std::vector<float>& want,
+                        double tolerance, const char* field) {
+  ASSERT_EQ(got.size(), want.size()) << field;
+  for (size_t i = 0; i < got.size(); ++i) EXPECT_NEAR(got[i], want[i], tolerance) << field << i;
+}
+
+void expect_clouds_near(const SplatCloud& got, const SplatCloud& want, double tolerance) {
+  EXPECT_EQ(got.sh_degree, want.sh_degree);
+  EXPECT_FALSE(got.has_filter_3d());
+  expect_values_near(got.positions, want.positions, tolerance, "position");
+  expect_values_near(got.sh_dc, want.sh_dc, tolerance, "f_dc");
+  expect_values_near(got.sh_rest, want.sh_rest, tolerance, "f_rest");
+  expect_values_near(got.opacity, want.opacity, tolerance, "opacity");
+  expect_values_near(got.log_scales, want.log_scales, tolerance, "log scale");
+  expect_values_near(got.rotations, want.rotations, tolerance, "rotation");
+}
+
+// reference_v*_decoded.ply: what the reference decoder (its spz_to_ply) makes of each file that
+// the reference encoder wrote from cloud.ply: version 2 (gzip, rotations as x y z), 3 (gzip,
+// smallest three), 4 (zstd stream per attribute), and 4 at SH degree 0, where the SH stream is
+// left out. Versions 3 and 4 quantize alike.
+TEST(SpzRead, DecodesEveryVersionAsTheReferenceDecoder) {
+  const std::pair<const char*, const char*> files[] = {
+      {"reference_v2.spz", "reference_v2_decoded.ply"},
+      {"reference_v3.spz", "reference_v4_decoded.ply"},
+      {"reference_v4.spz", "reference_v4_decoded.ply"},
+      {"reference_v4_degree0.spz", "reference_v4_degree0_decoded.ply"}};
+  for (const auto& [spz, decoded] : files) {
+    SCOPED_TRACE(spz);
+    expect_clouds_near(read_spz(kData / spz), read_ply(kData / decoded), 1e-6);
+  }
+}
+
+TEST(SpzRead, WrittenCloudsComeBackWithinTheirQuantization) {
+  TempDir dir;
+  SplatCloud cloud = one_gaussian();
+  cloud.sh_degree = 1;
+  cloud.sh_rest = {0.1f, -0.2f, 0.3f, 0.4f, -0.5f, 0.6f, -0.7f, 0.8f, -0.9f};
+  cloud.rotations = {0.3f, -0.5f, 0.2f, 0.7f};
+  write_spz(dir / "a.spz", cloud);
+  const SplatCloud back = read_spz(dir / "a.spz");
+  expect_values_near(back.positions, cloud.positions, 0.5 / 4096, "position");
+  expect_values_near(back.log_scales, cloud.log_scales, 0.5 / 16, "log scale");
+  expect_values_near(back.sh_dc, cloud.sh_dc, 0.51 / 255 / 0.15,
+                     "f_dc");                                            // 0.5 sits at a half step
+  expect_values_near(back.sh_rest, cloud.sh_rest, 4.0 / 128, "f_rest");  // 5-bit buckets
+  EXPECT_NEAR(sigmoid(back.opacity[0]), sigmoid(cloud.opacity[0]), 0.51 / 255);
+  // The same rotation, up to sign, to the 9 bits of each small component.
+  const double norm = quaternion_norm(cloud.rotations.data());
+  double dot = 0;
+  for (int k = 0; k < 4; ++k) dot += back.rotations[k] * cloud.rotations[k] / norm;
+  EXPECT_NEAR(std::fabs(dot), 1.0, 1e-5);
+}
+
+TEST(SpzRead, SaturatedOpacitiesStayFinite) {
+  TempDir dir;
+  SplatCloud cloud = one_gaussian();
+  for (float logit : {-30.f, 30.f}) {
+    cloud.opacity = {logit};
+    write_spz(dir / "a.spz", cloud);
+    const float back = read_spz(dir / "a.spz").opacity[0];
+    ASSERT_TRUE(std::isfinite(back)) << logit;
+    EXPECT_NEAR(sigmoid(back), logit < 0 ? 0.5 / 255 : 254.5 / 255, 1e-6);
+  }
+}
+
+TEST(SpzRead, MalformedFilesNameTheFileAndTheProblem) {
+  TempDir dir;
+  const std::string v3 = read_file(kData / "reference_v3.spz");
+  const std::string v4 = read_file(kData / "reference_v4.spz");
+  const auto problem = [&](const std::string& bytes) {
+    write_file_atomically(dir / "bad.spz", bytes);
+    return error_message([&] { read_spz(dir / "bad.spz"); });
+  };
+  std::string future = v4, streams = v4;
+  future[4] = 9;    // version
+  streams[15] = 5;  // stream count
+  const std::pair<std::string, const char*> cases[] = {
+      {"ply\nformat ascii 1.0\n", "bad.spz: not an .spz file"},
+      {v3.substr(0, v3.size() / 2), "bad.spz: corrupt or truncated gzip stream"},
+      {v4.substr(0, 40), "bad.spz: truncated data"},
+      {v4.substr(0, v4.size() - 10), "bad.spz: truncated data"},
+      {future, "bad.spz: unsupported .spz version 9"},
+      {streams, "bad.spz: 5 attribute streams where 7 Gaussians of SH degree 3 need 6"}};
+  for (const auto& [bytes, expected] : cases) {
+    const std::string message = problem(bytes);
+    EXPECT_TRUE(contains(message, expected)) << message;
+  }
+  const std::string missing = error_message([&] { read_spz(dir / "none.spz"); });
+  EXPECT_TRUE(contains(missing, "none.spz")) << missing;
 }
 
 }  // namespace
