@@ -22,7 +22,8 @@ namespace {
 constexpr uint32_t kMagic = 0x5053474e;  // "NGSP" in file order
 constexpr uint32_t kVersion = 3;
 constexpr uint32_t kOldestReadVersion = 2;  // version 1 (float16 positions) was never released
-constexpr uint32_t kFirstZstdVersion = 4;   // a stream per attribute, each zstd-compressed
+constexpr uint32_t kFirstSmallestThreeVersion = 3;  // 4-byte rotations; 3 bytes (x y z) before
+constexpr uint32_t kFirstZstdVersion = 4;           // a stream per attribute, each zstd-compressed
 constexpr uint32_t kNewestReadVersion = 4;
 constexpr uint8_t kAntialiased = 1;
 constexpr uint8_t kHasExtensions = 2;
@@ -142,11 +143,15 @@ struct SpzHeader {
   uint8_t flags = 0;
 };
 
+int rotation_bytes(const SpzHeader& h) {
+  return h.version >= kFirstSmallestThreeVersion ? 4 : 3;
+}
+
 // Uncompressed sizes of the attribute streams, in file order: positions, opacities, colours,
 // scales, rotations, higher SH bands.
 std::vector<uint64_t> stream_sizes(const SpzHeader& h) {
   const uint64_t n = h.count, rest = 3 * (uint64_t(h.sh_degree + 1) * (h.sh_degree + 1) - 1);
-  return {9 * n, n, 3 * n, 3 * n, (h.version >= 3 ? 4 : 3) * n, rest * n};
+  return {9 * n, n, 3 * n, 3 * n, rotation_bytes(h) * n, rest * n};
 }
 
 uint64_t total_bytes(const std::vector<uint64_t>& sizes) {
@@ -231,6 +236,7 @@ std::string zstd_streams(std::string_view file, SpzHeader& h) {
   if (stream_count != int(sizes.size()))
     throw FormatError(fmt::format("{} attribute streams where {} Gaussians of SH degree {} need {}",
                                   stream_count, h.count, h.sh_degree, sizes.size()));
+  // The slack of 64 bytes covers a zstd frame's own header on tiny streams.
   std::vector<uint64_t> compressed(sizes.size());
   for (size_t s = 0; s < sizes.size(); ++s) {
     compressed[s] = table.little<uint64_t>();
@@ -292,11 +298,11 @@ SplatCloud decode_streams(const SpzHeader& h, const std::string& streams) {
     cloud.sh_dc.push_back(float((uint8_t(c) / 255.0 - 0.5) / kColorScale));
   for (char c : in.take(3 * n)) cloud.log_scales.push_back(float(uint8_t(c) / 16.0 - 10));
   cloud.rotations.resize(4 * n);
-  const int rotation_bytes = h.version >= 3 ? 4 : 3;
-  const std::string_view rotations = in.take(rotation_bytes * n);
+  const int width = rotation_bytes(h);
+  const std::string_view rotations = in.take(width * n);
   for (size_t i = 0; i < n; ++i) {
-    const char* r = rotations.data() + rotation_bytes * i;
-    if (rotation_bytes == 4)
+    const char* r = rotations.data() + width * i;
+    if (width == 4)
       unpack_smallest_three(ByteReader(std::string_view(r, 4)).little<uint32_t>(),
                             &cloud.rotations[4 * i]);
     else
