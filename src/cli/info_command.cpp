@@ -8,7 +8,6 @@
 
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
-#include "core/paths.hpp"
 #include "io/model_file.hpp"
 #include "io/view_images.hpp"
 

@@ -32,10 +32,10 @@ GaussianModel model_from_positions_and_dc(const std::vector<float>& positions,
       torch::log(torch::sqrt(torch::clamp_min(tensor_of(dist2, {n}), 1e-7)));
   const float opacity = 0.1f;
   GaussianModel model;
-  model.set_params(
-      {tensor_of(positions, {n, 3}), tensor_of(sh_dc, {n, 1, 3}),
-       torch::zeros({n, kRestCoefficients, 3}), torch::full({n}, std::log(opacity / (1 - opacity))),
-       scale_log.unsqueeze(1).repeat({1, 3}), torch::tensor({1.f, 0.f, 0.f, 0.f}).repeat({n, 1})});
+  model.set_params({tensor_of(positions, {n, 3}), tensor_of(sh_dc, {n, 1, 3}),
+                    torch::zeros({n, kRestCoefficients, 3}), torch::full({n}, logit(opacity)),
+                    scale_log.unsqueeze(1).repeat({1, 3}),
+                    torch::tensor({1.f, 0.f, 0.f, 0.f}).repeat({n, 1})});
   return model;
 }
 
