@@ -257,30 +257,37 @@ float fixed_position(std::string_view bytes, size_t i, int bits) {
   return float(std::ldexp(double(int32_t(fixed)), -bits));
 }
 
+// Both rotation encodings store three components and let the fourth complete a unit vector.
+// Bytes no encoder writes can make the three longer than 1 on their own: the quaternion is then
+// normalized, as a renderer would, so that every decoded rotation is a unit one.
+void complete_unit_quaternion(double xyzw[4], int missing, float* wxyz) {
+  double sum = 0;
+  for (int i = 0; i < 4; ++i)
+    if (i != missing) sum += xyzw[i] * xyzw[i];
+  xyzw[missing] = std::sqrt(std::max(0.0, 1 - sum));
+  const double norm = std::sqrt(std::max(1.0, sum));
+  const int order[4] = {3, 0, 1, 2};
+  for (int k = 0; k < 4; ++k) wxyz[k] = float(xyzw[order[k]] / norm);
+}
+
 // Inverse of smallest_three, to (w x y z).
 void unpack_smallest_three(uint32_t packed, float* wxyz) {
   const int largest = int(packed >> 30);
-  double q[4], sum = 0;  // x y z w
+  double q[4] = {};  // x y z w
   for (int i = 3; i >= 0; --i) {
     if (i == largest) continue;
     const double magnitude = double(packed & 511) / 511 / std::sqrt(2.0);
     q[i] = packed >> 9 & 1 ? -magnitude : magnitude;
-    sum += q[i] * q[i];
     packed >>= 10;
   }
-  q[largest] = std::sqrt(std::max(0.0, 1 - sum));
-  wxyz[0] = float(q[3]), wxyz[1] = float(q[0]), wxyz[2] = float(q[1]), wxyz[3] = float(q[2]);
+  complete_unit_quaternion(q, largest, wxyz);
 }
 
 // Version 2's rotations: x y z of the unit quaternion with w >= 0, one byte each.
 void unpack_first_three(const char* bytes, float* wxyz) {
-  double sum = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double v = uint8_t(bytes[k]) / 127.5 - 1;
-    wxyz[k + 1] = float(v);
-    sum += v * v;
-  }
-  wxyz[0] = float(std::sqrt(std::max(0.0, 1 - sum)));
+  double q[4] = {};
+  for (int k = 0; k < 3; ++k) q[k] = uint8_t(bytes[k]) / 127.5 - 1;
+  complete_unit_quaternion(q, 3, wxyz);
 }
 
 SplatCloud decode_streams(const SpzHeader& h, const std::string& streams) {

@@ -197,6 +197,36 @@ TEST(SpzRead, SaturatedOpacitiesStayFinite) {
   }
 }
 
+// A one-Gaussian gzip .spz of the given version whose rotation is `rotation` (3 bytes for
+// version 2, 4 after), everything else zero.
+void write_legacy_spz(const std::filesystem::path& path, uint8_t version,
+                      const std::string& rotation) {
+  std::string bytes("NGSP", 4);
+  bytes += std::string{char(version), 0, 0, 0, 1, 0, 0, 0, 0, 12, 0, 0};  // count 1, degree 0
+  bytes += std::string(9 + 1 + 3 + 3, '\0') + rotation;
+  gzFile file = gzopen(path.c_str(), "wb");
+  ASSERT_NE(file, nullptr);
+  ASSERT_EQ(gzwrite(file, bytes.data(), unsigned(bytes.size())), int(bytes.size()));
+  ASSERT_EQ(gzclose(file), Z_OK);
+}
+
+// No encoder writes three stored components longer than 1, but a file can hold them.
+TEST(SpzRead, OverlongRotationsComeBackNormalized) {
+  TempDir dir;
+  const std::pair<uint8_t, std::string> files[] = {
+      {2, std::string(3, '\xff')},                        // x = y = z = 1
+      {3, std::string{'\xff', '\xff', '\xff', '\xdf'}}};  // all three at 1/sqrt(2), w dropped
+  for (const auto& [version, rotation] : files) {
+    SCOPED_TRACE(int(version));
+    write_legacy_spz(dir / "a.spz", version, rotation);
+    const SplatCloud cloud = read_spz(dir / "a.spz");
+    ASSERT_EQ(cloud.rotations.size(), 4u);
+    EXPECT_NEAR(quaternion_norm(cloud.rotations.data()), 1.0, 1e-6);
+    EXPECT_EQ(cloud.rotations[0], 0.0f);  // the completed component: nothing left for it
+    EXPECT_NEAR(cloud.rotations[1], 1 / std::sqrt(3.0), 1e-6);
+  }
+}
+
 TEST(SpzRead, MalformedFilesNameTheFileAndTheProblem) {
   TempDir dir;
   const std::string v3 = read_file(kData / "reference_v3.spz");
