@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds every libFuzzer harness (fuzz/<name>_fuzzer.cpp) with clang and runs each one for
 # SECONDS seconds (default 60). Each corpus grows in fuzz/corpus-<name>/ (git-ignored), seeded
-# from fuzz/corpus/<name>_fuzzer/ and tests/data/<name>/ where they exist; fuzz/<name>_fuzzer.dict
-# is used as a dictionary where it exists. Crashing inputs are saved as fuzz/crash-* (git-ignored).
+# from fuzz/corpus/<name>_fuzzer/, tests/data/<name>/ and tests/data/*/<name>/ where they exist;
+# fuzz/<name>_fuzzer.dict is used as a dictionary where it exists. Crashing inputs are saved as
+# fuzz/crash-* (git-ignored).
 # Exits non-zero when any harness found a failure.
 #
 # usage: scripts/fuzz.sh [SECONDS] [NAME...]    (NAME: run only these harnesses, e.g. colmap)
@@ -40,7 +41,7 @@ for name in "${names[@]}"; do
   dict=$root/fuzz/${name}_fuzzer.dict
   [[ -f $dict ]] && options+=(-dict="$dict")
   seeds=()
-  for seed in "$root/fuzz/corpus/${name}_fuzzer" "$root/tests/data/$name"; do
+  for seed in "$root/fuzz/corpus/${name}_fuzzer" "$root/tests/data/$name" "$root"/tests/data/*/"$name"; do
     [[ -d $seed ]] && seeds+=("$seed")
   done
   echo "== $name: ${seconds}s, corpus $corpus"
