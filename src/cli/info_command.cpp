@@ -49,6 +49,8 @@ void print_model_summary(const std::filesystem::path& path) {
   fmt::print("gaussians   {}\n", n);
   fmt::print("sh degree   {}\n", cloud.sh_degree);
   fmt::print("3D filter   {}\n", cloud.has_filter_3d() ? "yes (Mip-Splatting)" : "no");
+  fmt::print("2D filter   {}\n",
+             cloud.antialiased ? "Mip-Splatting's (antialiased)" : "3DGS's dilation (classic)");
   if (n == 0) return;
   Vec3 low{INFINITY, INFINITY, INFINITY}, high = -low;
   std::vector<double> opacity(n), largest_scale(n);

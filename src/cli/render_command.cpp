@@ -26,10 +26,12 @@ struct RenderArgs {
   double scale = 1;
   std::string path;
   int frames = 120;
+  std::string rasterize_mode = "auto";
 };
 
 void run_render(const RenderArgs& args) {
-  const gs::GaussianModel model = gs::model_from_splat_cloud(read_model(model_file(args.model)));
+  gs::GaussianModel model = gs::model_from_splat_cloud(read_model(model_file(args.model)));
+  if (args.rasterize_mode != "auto") model.antialiased = args.rasterize_mode == "antialiased";
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   const std::string what = args.path.empty() ? args.split : args.path + " path";
   std::vector<Camera> cameras;
@@ -43,15 +45,19 @@ void run_render(const RenderArgs& args) {
                                    : pipeline::interpolated_path(train, args.frames);
   }
   if (cameras.empty()) fail_file(scene.root, fmt::format("has no {} views", args.split));
-  fmt::print("rendering {} {} views of {} Gaussians at x{}\n", cameras.size(), what, model.size(),
-             args.scale);
+  const char* mode = model.antialiased ? "antialiased" : "classic";
+  fmt::print("rendering {} {} views of {} Gaussians at x{} ({})\n", cameras.size(), what,
+             model.size(), args.scale, mode);
   const double seconds =
       pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
   const Camera first = cameras.front().scaled(args.scale);
-  const nlohmann::json report = {
-      {"views", cameras.size()},           {"width", first.intrinsics.width},
-      {"height", first.intrinsics.height}, {"gaussians", model.size()},
-      {"seconds_per_view", seconds},       {"fps", seconds > 0 ? 1.0 / seconds : 0.0}};
+  const nlohmann::json report = {{"views", cameras.size()},
+                                 {"width", first.intrinsics.width},
+                                 {"height", first.intrinsics.height},
+                                 {"gaussians", model.size()},
+                                 {"rasterize_mode", mode},
+                                 {"seconds_per_view", seconds},
+                                 {"fps", seconds > 0 ? 1.0 / seconds : 0.0}};
   write_file_atomically(std::filesystem::path(args.output) / "render.json", report.dump(2) + "\n");
   fmt::print("{:.1f} ms per view ({:.1f} FPS); wrote {}\n", seconds * 1e3,
              seconds > 0 ? 1.0 / seconds : 0.0, args.output);
@@ -82,6 +88,12 @@ void add_render_command(CLI::App& app) {
       ->check(CLI::IsMember({"orbit", "interp"}));
   command->add_option("--frames", args->frames, "Frames of --path")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command
+      ->add_option("--rasterize-mode", args->rasterize_mode,
+                   "2D filter: antialiased (Mip-Splatting's), classic (3DGS's dilation) or auto, "
+                   "the model's own (antialiased with a filter_3D or an .spz flagged so)")
+      ->check(CLI::IsMember({"auto", "antialiased", "classic"}))
       ->capture_default_str();
   command->callback([args] { run_render(*args); });
 }

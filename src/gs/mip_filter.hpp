@@ -3,13 +3,16 @@
 // 3D smoothing filter: the world-space covariance gets filter_std^2 on its diagonal (in the
 // Gaussian's own frame, i.e. on every scale) and the opacity is scaled so that the integral is
 // unchanged. 2D mip filter: the screen-space covariance gets kMipFilterVariance on its diagonal
-// and the opacity the matching factor.
+// and the opacity the matching factor. Models trained without it (3DGS, most .spz files) are
+// drawn with 3DGS's dilation instead, as they were trained: more variance, opacity unchanged.
 #include "raster/geometry.hpp"
 
 namespace iesrgs::gs {
 
-// Variance in pixels^2 of the screen-space box-filter approximation (3DGS dilates by 0.3).
+// Variance in pixels^2 of the screen-space box-filter approximation.
 constexpr double kMipFilterVariance = 0.1;
+// 3DGS's screen-space dilation, in pixels^2, for models without the mip filter ("classic").
+constexpr double kClassicDilation = 0.3;
 // Floor on det(cov) / det(cov + filter), as Mip-Splatting, for numerical stability.
 constexpr double kMinMipDetRatio = 0.000025;
 
@@ -41,22 +44,29 @@ IESRGS_HD void filter3d_backward(const T* scale, T filter_std, const T* dvar, T 
     dlog_scale[k] = T(2) * scale[k] * scale[k] * dvar[k] + dfactor * factor * f2 / var[k];
 }
 
-// Returns the opacity factor and writes the filtered covariance.
+// The variance the screen-space filter adds: the mip filter's, or 3DGS's dilation.
+IESRGS_HD double filter2d_variance(bool antialiased) {
+  return antialiased ? kMipFilterVariance : kClassicDilation;
+}
+
+// Returns the opacity factor (1 for the dilation) and writes the filtered covariance.
 template <typename T>
-IESRGS_HD T filter2d(const raster::Sym2<T>& cov, raster::Sym2<T>& filtered) {
-  const T h = T(kMipFilterVariance);
+IESRGS_HD T filter2d(const raster::Sym2<T>& cov, bool antialiased, raster::Sym2<T>& filtered) {
+  const T h = T(filter2d_variance(antialiased));
   filtered = {cov.xx + h, cov.xy, cov.yy + h};
+  if (!antialiased) return T(1);
   return hd::sqrt(hd::max(T(kMinMipDetRatio), raster::det(cov) / raster::det(filtered)));
 }
 
 // dL/dcov from dL/dfiltered and dL/dfactor (no factor gradient where the floor is active).
 template <typename T>
-IESRGS_HD raster::Sym2<T> filter2d_backward(const raster::Sym2<T>& cov,
+IESRGS_HD raster::Sym2<T> filter2d_backward(const raster::Sym2<T>& cov, bool antialiased,
                                             const raster::Sym2<T>& dfiltered, T dfactor) {
-  raster::Sym2<T> filtered;
-  const T factor = filter2d(cov, filtered);
-  const T det0 = raster::det(cov), det1 = raster::det(filtered);
   raster::Sym2<T> dcov = dfiltered;
+  if (!antialiased) return dcov;
+  raster::Sym2<T> filtered;
+  const T factor = filter2d(cov, antialiased, filtered);
+  const T det0 = raster::det(cov), det1 = raster::det(filtered);
   if (det0 / det1 <= T(kMinMipDetRatio)) return dcov;
   // factor = sqrt(det0 / det1); d det / d(xx, xy, yy) = (yy, -2 xy, xx)
   const T g = dfactor / (T(2) * factor * det1);

@@ -84,8 +84,8 @@ const torch::Tensor& GaussianModel::param(Param p) const {
 }
 
 raster::GaussianTensors GaussianModel::render_tensors() const {
-  return {means,     log_scales,      quats, opacity_logits, torch::cat({sh_dc, sh_rest}, 1),
-          filter_3d, active_sh_degree};
+  return {means,     log_scales,       quats,      opacity_logits, torch::cat({sh_dc, sh_rest}, 1),
+          filter_3d, active_sh_degree, antialiased};
 }
 
 GaussianModel GaussianModel::clone() const {
@@ -152,6 +152,7 @@ SplatCloud to_splat_cloud(const GaussianModel& model) {
   cloud.log_scales = values_of(model.log_scales);
   cloud.rotations = values_of(model.quats);
   if (model.filter_3d.defined()) cloud.filter_3d = values_of(model.filter_3d);
+  cloud.antialiased = model.antialiased;
   return cloud;
 }
 
@@ -164,6 +165,7 @@ GaussianModel model_from_splat_cloud(const SplatCloud& cloud) {
                     tensor_of(cloud.log_scales, {n, 3}), tensor_of(cloud.rotations, {n, 4})});
   if (cloud.has_filter_3d()) model.filter_3d = tensor_of(cloud.filter_3d, {n});
   model.active_sh_degree = cloud.sh_degree;
+  model.antialiased = cloud.antialiased;
   return model;
 }
 

@@ -27,6 +27,7 @@ struct GaussianModel {
   torch::Tensor quats;           // (N, 4) w x y z
   torch::Tensor filter_3d;       // (N) Mip-Splatting 3D filter std, not optimized; undefined = none
   int active_sh_degree = 0;
+  bool antialiased = true;  // drawn with Mip-Splatting's 2D filter (what training uses)
 
   int64_t size() const { return means.size(0); }
   torch::Tensor& param(Param p);

@@ -472,6 +472,7 @@ SplatCloud parse_ply(std::string_view bytes, const fs::path& name) {
     read_body(AsciiValues(body, name), header, targets, cloud, name);
   else
     read_body(BinaryValues(body), header, targets, cloud, name);
+  cloud.antialiased = has_filter;
   return cloud;
 }
 

@@ -18,6 +18,9 @@ struct SplatCloud {
   std::vector<float> log_scales;  // (N, 3)
   std::vector<float> rotations;   // (N, 4), quaternion w x y z, not necessarily normalized
   std::vector<float> filter_3d;   // (N) Mip-Splatting 3D filter std, or empty when absent
+  // Trained with Mip-Splatting's 2D mip filter, which renderers must then use; false for 3DGS's
+  // dilation. Kept when the 3D filter is baked.
+  bool antialiased = true;
 
   size_t size() const { return positions.size() / 3; }
   bool has_filter_3d() const { return !filter_3d.empty(); }
@@ -44,7 +47,10 @@ void write_ply_filter_baked(const std::filesystem::path& path, const SplatCloud&
 
 // Reads ascii or binary_little_endian files with the properties in any order and any scalar type;
 // unknown properties and elements after the vertex element are skipped. The SH degree follows from
-// the number of f_rest properties. Throws Error naming the file for anything it cannot use.
+// the number of f_rest properties. A .ply has no flag for the 2D filter: the cloud is antialiased
+// when it has Mip-Splatting's filter_3D, which only its trainers write, and otherwise is drawn as
+// 3DGS and the viewers draw it (this includes write_ply_filter_baked's own output). Throws Error
+// naming the file for anything it cannot use.
 SplatCloud read_ply(const std::filesystem::path& path);
 
 // read_ply on bytes already in memory; `name` is only used in error messages.

@@ -295,6 +295,7 @@ SplatCloud decode_streams(const SpzHeader& h, const std::string& streams) {
   ByteReader in(streams);
   SplatCloud cloud;
   cloud.sh_degree = h.sh_degree;
+  cloud.antialiased = h.flags & kAntialiased;
   const std::string_view positions = in.take(9 * n);
   for (size_t i = 0; i < 3 * n; ++i)
     cloud.positions.push_back(fixed_position(positions, i, h.bits));
@@ -323,7 +324,7 @@ SplatCloud decode_streams(const SpzHeader& h, const std::string& streams) {
 
 void write_spz(const std::filesystem::path& path, const SplatCloud& cloud) {
   const SplatCloud baked = viewer_cloud(cloud, path);
-  const uint8_t flags = cloud.has_filter_3d() ? kAntialiased : 0;
+  const uint8_t flags = cloud.antialiased ? kAntialiased : 0;
   write_file_atomically(path, gzip(encode(baked, flags, fractional_bits(baked, path)), path));
 }
 

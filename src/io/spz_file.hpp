@@ -14,14 +14,15 @@ namespace iesrgs {
 // opacities, colours (0.5 + 0.15 f_dc), log scales, rotations as the smallest three quaternion
 // components and higher SH bands quantized to 5 (degree 1) and 4 bits. Coordinates are the
 // .ply's, unconverted, as the reference ply_to_spz writes them. The 3D filter is baked in first
-// and, when the cloud had one, the "antialiased" flag tells the viewer to use Mip-Splatting's 2D
-// filter. Written atomically; throws Error naming the file for a malformed or non-finite cloud.
+// and, for an antialiased cloud, the "antialiased" flag tells the viewer to use Mip-Splatting's
+// 2D filter. Written atomically; throws Error naming the file for a malformed or non-finite cloud.
 void write_spz(const std::filesystem::path& path, const SplatCloud& cloud);
 
 // Reads versions 2 and 3 (gzip) and 4 (one zstd stream per attribute) into raw 3DGS parameters:
 // logit opacities (bytes 0 and 255 half a quantization step inside (0, 1), where they would be
 // infinite), colours back to f_dc, unit quaternions. A written 3D filter stays baked in, so the
-// cloud has no filter_3d. Throws Error naming the file for anything it cannot decode.
+// cloud has no filter_3d; the "antialiased" flag sets the cloud's. Throws Error naming the file
+// for anything it cannot decode.
 SplatCloud read_spz(const std::filesystem::path& path);
 
 // read_spz on bytes already in memory; `name` is only used in error messages.

@@ -43,10 +43,11 @@ void check_inputs(const GaussianTensors& g, const ViewspaceProbes& probes) {
 
 GaussianParams<float> params_of(const Tensor& means, const Tensor& log_scales, const Tensor& quats,
                                 const Tensor& logits, const Tensor& sh, const Tensor& filter_std,
-                                int sh_degree) {
+                                int sh_degree, bool antialiased) {
   GaussianParams<float> g;
   g.count = int(means.size(0));
   g.sh_degree = sh_degree;
+  g.antialiased = antialiased;
   g.means = means.data_ptr<float>();
   g.log_scales = log_scales.data_ptr<float>();
   g.quats = quats.data_ptr<float>();
@@ -67,7 +68,7 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
   static variable_list forward(AutogradContext* ctx, Tensor means, Tensor log_scales, Tensor quats,
                                Tensor logits, Tensor sh, Tensor filter_std, Tensor /*probe*/,
                                Tensor /*abs_probe*/, RasterCamera<float> camera,
-                               std::array<float, 3> background, int64_t sh_degree,
+                               std::array<float, 3> background, int64_t sh_degree, bool antialiased,
                                std::array<bool, 3> present) {
     means = means.contiguous();
     log_scales = log_scales.contiguous();
@@ -76,7 +77,7 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     sh = sh.contiguous();
     filter_std = present[0] ? filter_std.contiguous() : Tensor();
     const GaussianParams<float> g =
-        params_of(means, log_scales, quats, logits, sh, filter_std, int(sh_degree));
+        params_of(means, log_scales, quats, logits, sh, filter_std, int(sh_degree), antialiased);
     auto holder = c10::make_intrusive<FrameHolder>();
     const auto f32 = torch::TensorOptions().dtype(torch::kFloat32);
     Tensor image = torch::empty({3, camera.height, camera.width}, f32);
@@ -89,6 +90,7 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     ctx->save_for_backward({means, log_scales, quats, logits, sh, filter_std});
     ctx->saved_data["frame"] = c10::IValue::make_capsule(holder);
     ctx->saved_data["sh_degree"] = sh_degree;
+    ctx->saved_data["antialiased"] = antialiased;
     ctx->saved_data["probe"] = present[1];
     ctx->saved_data["abs_probe"] = present[2];
     ctx->mark_non_differentiable({radii});
@@ -99,7 +101,8 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     const variable_list saved = ctx->get_saved_variables();
     const Tensor& means = saved[0];
     const GaussianParams<float> g = params_of(means, saved[1], saved[2], saved[3], saved[4],
-                                              saved[5], int(ctx->saved_data["sh_degree"].toInt()));
+                                              saved[5], int(ctx->saved_data["sh_degree"].toInt()),
+                                              ctx->saved_data["antialiased"].toBool());
     auto holder =
         c10::static_intrusive_pointer_cast<FrameHolder>(ctx->saved_data["frame"].toCapsule());
     Tensor dmeans = torch::empty_like(means), dlog_scales = torch::empty_like(saved[1]);
@@ -121,8 +124,8 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
                              dsh.data_ptr<float>(),
                              dprobe.defined() ? dprobe.data_ptr<float>() : nullptr,
                              dabs_probe.defined() ? dabs_probe.data_ptr<float>() : nullptr});
-    return {dmeans, dlog_scales, dquats,   dlogits,  dsh,      Tensor(),
-            dprobe, dabs_probe,  Tensor(), Tensor(), Tensor(), Tensor()};
+    return {dmeans,     dlog_scales, dquats,   dlogits,  dsh,      Tensor(), dprobe,
+            dabs_probe, Tensor(),    Tensor(), Tensor(), Tensor(), Tensor()};
   }
 };
 
@@ -136,6 +139,7 @@ RenderOutput render(const GaussianTensors& gaussians, const RasterCamera<float>&
       gaussians.means, gaussians.log_scales, gaussians.quats, gaussians.opacity_logits,
       gaussians.sh, or_placeholder(gaussians.filter_std), or_placeholder(probes.grad),
       or_placeholder(probes.abs_grad), camera, background, int64_t(gaussians.sh_degree),
+      gaussians.antialiased,
       std::array<bool, 3>{gaussians.filter_std.defined(), probes.grad.defined(),
                           probes.abs_grad.defined()});
   return {out[0], out[1], out[2], out[3]};

@@ -17,6 +17,7 @@ struct GaussianTensors {
   torch::Tensor sh;              // (N, 16, 3)
   torch::Tensor filter_std;      // (N) Mip-Splatting 3D filter, no gradient; undefined = none
   int sh_degree = 0;
+  bool antialiased = true;  // Mip-Splatting's 2D filter; false: 3DGS's dilation
 };
 
 struct RenderOutput {

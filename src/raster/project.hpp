@@ -1,7 +1,8 @@
 #pragma once
 // Projection of one Gaussian to a screen-space splat, and its backward pass, following 3DGS
 // (EWA splatting with the Jacobian clamped at 1.3 x tan(fov / 2)) with Mip-Splatting's 3D
-// smoothing filter and 2D mip filter. The backward pass recomputes the forward intermediates.
+// smoothing filter and 2D mip filter, or 3DGS's dilation for models trained without it. The
+// backward pass recomputes the forward intermediates.
 #include "gs/mip_filter.hpp"
 #include "gs/sh.hpp"
 #include "raster/geometry.hpp"
@@ -53,7 +54,7 @@ IESRGS_HD Vec3T<T> camera_center(const RasterCamera<T>& cam) {
 // cov = (J W R) diag(var) (J W R)^T: a sum of non-negative terms, accurate even for needle-like
 // splats, where xx yy - xy^2 cancels. Used for loop bounds, which must not be too tight.
 template <typename T>
-IESRGS_HD T stable_filtered_det(const Projection<T>& p) {
+IESRGS_HD T stable_filtered_det(const Projection<T>& p, T h) {
   T m[2][3];
   for (int r = 0; r < 2; ++r)
     for (int k = 0; k < 3; ++k)
@@ -65,7 +66,6 @@ IESRGS_HD T stable_filtered_det(const Projection<T>& p) {
       const T minor = m[0][i] * m[1][j] - m[0][j] * m[1][i];
       det_cov += p.var[i] * p.var[j] * minor * minor;
     }
-  const T h = T(gs::kMipFilterVariance);
   return det_cov + h * (p.cov.xx + p.cov.yy) + h * h;
 }
 
@@ -113,10 +113,10 @@ IESRGS_HD bool project(const GaussianParams<T>& g, int i, const RasterCamera<T>&
       cov[r][c] = s;
     }
   p.cov = {cov[0][0], cov[0][1], cov[1][1]};
-  p.opacity2d = gs::filter2d(p.cov, p.filtered);
+  p.opacity2d = gs::filter2d(p.cov, g.antialiased, p.filtered);
   if (!(det(p.filtered) > T(0))) return false;
   p.conic = inverse(p.filtered);
-  p.filtered_det = stable_filtered_det(p);
+  p.filtered_det = stable_filtered_det(p, T(gs::filter2d_variance(g.antialiased)));
   return true;
 }
 
@@ -203,7 +203,7 @@ IESRGS_HD void project_backward(const GaussianParams<T>& g, int i, const RasterC
   // Conic -> filtered covariance -> covariance.
   const Sym2<T> dfiltered =
       inverse_backward(p.conic, Sym2<T>{ds.conic_xx, ds.conic_xy, ds.conic_yy});
-  const Sym2<T> dcov = gs::filter2d_backward(p.cov, dfiltered, dopacity2d);
+  const Sym2<T> dcov = gs::filter2d_backward(p.cov, g.antialiased, dfiltered, dopacity2d);
   const T g2[2][2] = {{dcov.xx, T(0.5) * dcov.xy}, {T(0.5) * dcov.xy, dcov.yy}};
 
   // cov = (J W) sigma (J W)^T: dsigma = (J W)^T g2 (J W), d(J W) = 2 g2 (J W) sigma.

@@ -30,6 +30,7 @@ struct GaussianParams {
   const T* opacity_logits = nullptr;  // (N)
   const T* sh = nullptr;              // (N, 16, 3)
   const T* filter_std = nullptr;      // (N) Mip-Splatting 3D filter; nullptr means none
+  bool antialiased = true;  // Mip-Splatting's 2D filter; false: 3DGS's dilation ("classic")
 };
 
 // Owning storage behind GaussianParams: the benchmarks' scenes and the kernel tests' scenes.
@@ -37,6 +38,7 @@ template <typename T>
 struct GaussianBuffers {
   int sh_degree = 3;
   std::vector<T> means, log_scales, quats, opacity_logits, sh, filter_std;
+  bool antialiased = true;
 
   int count() const { return int(opacity_logits.size()); }
   GaussianParams<T> params() const {
@@ -49,6 +51,7 @@ struct GaussianBuffers {
     g.opacity_logits = opacity_logits.data();
     g.sh = sh.data();
     g.filter_std = filter_std.data();
+    g.antialiased = antialiased;
     return g;
   }
 };

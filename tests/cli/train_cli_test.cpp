@@ -80,9 +80,18 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   ASSERT_EQ(described.status, 0) << described.output;
   EXPECT_TRUE(contains(described.output, fmt::format("gaussians   {}", gaussians)))
       << described.output;
+  EXPECT_TRUE(contains(described.output, "2D filter   Mip-Splatting's (antialiased)"))
+      << described.output;
   const CliRun rendered =
       iesrgs("render " + spz.string() + " " + scene + " -o " + (dir / "from_spz").string());
   ASSERT_EQ(rendered.status, 0) << rendered.output;
+  EXPECT_TRUE(contains(rendered.output, "(antialiased)")) << rendered.output;
+  const CliRun classic = iesrgs("render " + spz.string() + " " + scene + " -o " +
+                                (dir / "classic").string() + " --rasterize-mode classic");
+  ASSERT_EQ(classic.status, 0) << classic.output;
+  EXPECT_TRUE(contains(classic.output, "(classic)")) << classic.output;
+  EXPECT_NE(read_image8(dir / "classic" / "rgb" / "r_0.png").data,
+            read_image8(dir / "from_spz" / "rgb" / "r_0.png").data);
   // Quantized to a byte or so per value, the model renders as the .ply does to a few levels.
   const Image8 from_spz = read_image8(dir / "from_spz" / "rgb" / "r_0.png");
   const Image8 from_ply = read_image8(dir / "same" / "rgb" / "r_0.png");

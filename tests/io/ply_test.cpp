@@ -73,6 +73,8 @@ TEST(Ply, RoundTripsEveryShDegreeWithAndWithoutFilter) {
       const SplatCloud back = read_ply(dir / "scene.ply");
       expect_same(back, cloud);
       EXPECT_EQ(back.has_filter_3d(), with_filter);
+      // Only Mip-Splatting writes filter_3D; any other .ply is drawn as 3DGS draws it.
+      EXPECT_EQ(back.antialiased, with_filter);
     }
 }
 

@@ -18,9 +18,11 @@ std::vector<float> values(const torch::Tensor& t) {
   return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
 }
 
-TEST(RasterAutograd, GradientsMatchTheRawBackward) {
+// The 2D filter choice travels through autograd's saved state to the backward pass.
+void expect_gradients_match_the_raw_backward(bool antialiased) {
   const Camera cam = posed_test_camera(48, 40);
-  const Scene<float> s = random_scene(cam, 40, 3, 17).cast<float>();
+  Scene<float> s = random_scene(cam, 40, 3, 17).cast<float>();
+  s.antialiased = antialiased;
   const int64_t n = s.count();
   const float bg[3] = {0.1f, 0.2f, 0.3f};
   GaussianTensors g{tensor_of(s.means, {n, 3}),
@@ -29,7 +31,8 @@ TEST(RasterAutograd, GradientsMatchTheRawBackward) {
                     tensor_of(s.opacity_logits, {n}),
                     tensor_of(s.sh, {n, 16, 3}),
                     torch::tensor(s.filter_std),
-                    s.sh_degree};
+                    s.sh_degree,
+                    antialiased};
   ViewspaceProbes probes{torch::zeros({n, 2}).set_requires_grad(true),
                          torch::zeros({n, 2}).set_requires_grad(true)};
   const RenderOutput out = render(g, raster_camera<float>(cam), {bg[0], bg[1], bg[2]}, probes);
@@ -58,6 +61,14 @@ TEST(RasterAutograd, GradientsMatchTheRawBackward) {
   EXPECT_EQ(values(probes.grad.grad()), dview);
   EXPECT_EQ(values(probes.abs_grad.grad()), dview_abs);
   EXPECT_GT(torch::abs(g.means.grad()).sum().item<float>(), 0.f);
+}
+
+TEST(RasterAutograd, GradientsMatchTheRawBackward) {
+  expect_gradients_match_the_raw_backward(true);
+}
+
+TEST(RasterAutograd, ClassicGradientsMatchTheRawBackward) {
+  expect_gradients_match_the_raw_backward(false);
 }
 
 TEST(RasterAutograd, FilterAndProbesAreOptional) {

@@ -125,6 +125,13 @@ TEST(RasterBackward, MatchesFiniteDifferencesAtEveryShDegree) {
   }
 }
 
+TEST(RasterBackward, ClassicDilationMatchesFiniteDifferences) {
+  const Camera cam = posed_test_camera(24, 20);
+  Scene<double> s = random_scene(cam, 10, 1, 31, false);
+  s.antialiased = false;
+  check_every_group(cam, s, 32);
+}
+
 // The blending stage alone against finite differences of the splat fields, which also checks
 // the screen-space gradients reported for densification.
 TEST(RasterBackward, SplatGradientsMatchFiniteDifferences) {

@@ -26,6 +26,7 @@ struct Scene : GaussianBuffers<T> {
     s.opacity_logits = conv(this->opacity_logits);
     s.sh = conv(this->sh);
     s.filter_std = conv(this->filter_std);
+    s.antialiased = this->antialiased;
     return s;
   }
   // Appends one Gaussian; sh_dc sets the DC color term, higher bands from `rest`.

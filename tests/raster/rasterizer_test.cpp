@@ -17,11 +17,13 @@ struct ReferenceCase {
   Camera camera;
   int degree;
   unsigned seed;
+  bool antialiased = true;
 };
 
 void expect_matches_reference(const ReferenceCase& c, double tolerance_float,
                               double tolerance_double) {
-  const Scene<double> scene = random_scene(c.camera, 60, c.degree, c.seed);
+  Scene<double> scene = random_scene(c.camera, 60, c.degree, c.seed);
+  scene.antialiased = c.antialiased;
   const ReferenceImage ref = reference_render(scene, c.camera, kRasterBackground);
   const float bg[3] = {float(kRasterBackground[0]), float(kRasterBackground[1]),
                        float(kRasterBackground[2])};
@@ -38,11 +40,10 @@ void expect_matches_reference(const ReferenceCase& c, double tolerance_float,
 
 TEST(RasterForward, MatchesReferenceOnRandomScenes) {
   // Sizes that are not multiples of the tile size exercise the partial border tiles.
-  const std::vector<ReferenceCase> cases = {{test_camera(64, 48), 3, 1},
-                                            {posed_test_camera(70, 53), 3, 2},
-                                            {posed_test_camera(33, 47), 1, 3},
-                                            {test_camera(96, 80), 0, 4},
-                                            {posed_test_camera(64, 64), 2, 5}};
+  const std::vector<ReferenceCase> cases = {
+      {test_camera(64, 48), 3, 1},       {posed_test_camera(70, 53), 3, 2},
+      {posed_test_camera(33, 47), 1, 3}, {test_camera(96, 80), 0, 4},
+      {posed_test_camera(64, 64), 2, 5}, {posed_test_camera(70, 53), 3, 6, false}};
   for (const ReferenceCase& c : cases) {
     SCOPED_TRACE(::testing::Message() << "seed " << c.seed);
     expect_matches_reference(c, 1e-4, 1e-12);
@@ -70,24 +71,27 @@ TEST(RasterForward, EdgeCasesAreExercised) {
   EXPECT_GT(stopped, 10u);
 }
 
-TEST(RasterForward, SingleIsotropicGaussianHasClosedForm) {
+// Mip-Splatting's filter adds 0.1 px^2 and scales the opacity by the square root of the ratio of
+// determinants; 3DGS's dilation adds 0.3 px^2 and leaves the opacity alone.
+void expect_isotropic_closed_form(bool antialiased) {
   const Camera cam = test_camera(40, 40);
   const Intrinsics& k = cam.intrinsics;
   const double z = 4, scale = 0.3, opacity = 0.8, value = 0.7;
   Scene<double> s;
+  s.antialiased = antialiased;
   // On the optical axis the Jacobian is diag(f / z): the splat is isotropic with std f s / z.
   const double dc = (value - 0.5) / 0.28209479177387814;
   s.add({0, 0, z}, {std::log(scale), std::log(scale), std::log(scale)}, {1, 0, 0, 0},
         std::log(opacity / (1 - opacity)), {dc, dc, dc}, 0);
   const KernelRender<double> r = kernel_render(s, cam, kRasterBackground);
-  const double var = std::pow(k.fx * scale / z, 2);
-  const double filtered_opacity = opacity * var / (var + 0.1);  // sqrt of the det ratio
+  const double var = std::pow(k.fx * scale / z, 2), h = antialiased ? 0.1 : 0.3;
+  const double filtered_opacity = antialiased ? opacity * var / (var + h) : opacity;
   const size_t plane = size_t(k.width) * k.height;
   for (int y = 0; y < k.height; ++y)
     for (int x = 0; x < k.width; ++x) {
       const double d2 = std::pow(x + 0.5 - k.cx, 2) + std::pow(y + 0.5 - k.cy, 2);
       double alpha =
-          std::min(double(kMaxAlpha), filtered_opacity * std::exp(-0.5 * d2 / (var + 0.1)));
+          std::min(double(kMaxAlpha), filtered_opacity * std::exp(-0.5 * d2 / (var + h)));
       if (alpha < kMinAlpha) alpha = 0;
       const size_t i = size_t(y) * k.width + x;
       ASSERT_NEAR(r.alpha[i], alpha, 1e-12);
@@ -96,6 +100,14 @@ TEST(RasterForward, SingleIsotropicGaussianHasClosedForm) {
         ASSERT_NEAR(r.image[c * plane + i], alpha * value + (1 - alpha) * kRasterBackground[c],
                     1e-12);
     }
+}
+
+TEST(RasterForward, SingleIsotropicGaussianHasClosedForm) {
+  expect_isotropic_closed_form(true);
+}
+
+TEST(RasterForward, ClassicDilationHasClosedForm) {
+  expect_isotropic_closed_form(false);
 }
 
 // Box-averages a (3 or 1, H, W) planar image by an integer factor.

@@ -72,14 +72,16 @@ inline bool reference_project(const Scene<double>& s, int i, const Camera& cam,
   const Mat3 t = j * cam.rotation;
   const Mat3 cov = t * sigma * t.transposed();
   const double det0 = cov(0, 0) * cov(1, 1) - cov(0, 1) * cov(1, 0);
-  const double a = cov(0, 0) + 0.1, b = cov(0, 1), c = cov(1, 1) + 0.1;
+  // Mip-Splatting's 2D filter, or 3DGS's dilation without opacity compensation.
+  const double h = s.antialiased ? 0.1 : 0.3;
+  const double a = cov(0, 0) + h, b = cov(0, 1), c = cov(1, 1) + h;
   const double det1 = a * c - b * b;
   if (!(det1 > 0)) return false;
   out.x = k.fx * v.x / v.z + k.cx;
   out.y = k.fy * v.y / v.z + k.cy;
   out.depth = v.z;
   out.opacity = 1 / (1 + std::exp(-s.opacity_logits[i])) * std::sqrt(ratio3d) *
-                std::sqrt(std::max(0.000025, det0 / det1));
+                (s.antialiased ? std::sqrt(std::max(0.000025, det0 / det1)) : 1.0);
   out.conic[0] = c / det1;
   out.conic[1] = -b / det1;
   out.conic[2] = a / det1;

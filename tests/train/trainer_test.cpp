@@ -160,6 +160,16 @@ TEST_F(TrainerTest, PointCloudsRoundTripThroughPly) {
   const gs::GaussianModel back = gs::model_from_splat_cloud(read_ply(out / "point_cloud.ply"));
   EXPECT_LT(max_difference(back, trainer.model()), 1e-6);
   EXPECT_TRUE(std::filesystem::exists(out / "point_cloud_filter_baked.ply"));
+  EXPECT_TRUE(back.antialiased);
+}
+
+// A 3DGS model as the start (drawn with the dilation) still trains as Mip-Splatting.
+TEST_F(TrainerTest, TrainingIsAntialiasedWhateverTheStart) {
+  TempDir out;
+  gs::GaussianModel classic = initial();
+  classic.antialiased = false;
+  const Trainer trainer(config(), setup(out.path()), classic);
+  EXPECT_TRUE(trainer.model().antialiased);
 }
 
 }  // namespace
