@@ -83,7 +83,7 @@ Trainer::Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianMode
   torch::manual_seed(config_.seed);
   view_rng_.seed(config_.seed);
   model_.active_sh_degree = std::min(model_.active_sh_degree, config_.max_sh_degree);
-  if (!model_.filter_3d.defined()) gs::update_filter_3d(model_, train_cameras_);
+  gs::update_filter_3d(model_, train_cameras_);  // a start model's filter fits other cameras
   model_.antialiased = true;  // Mip-Splatting, whatever a starting .ply was drawn with
   optimizer_.emplace(model_, config_.learning_rates, setup_.scene_extent);
   stats_ = gs::DensifyStats::zeros(model_.size());

@@ -64,6 +64,12 @@ class TrainerTest : public ::testing::Test {
 
 TempDir* TrainerTest::dir_ = nullptr;
 
+std::vector<Camera> cameras(const TrainerSetup& s) {
+  std::vector<Camera> result;
+  for (const TrainView& view : s.train_views) result.push_back(view.camera);
+  return result;
+}
+
 double max_difference(const gs::GaussianModel& a, const gs::GaussianModel& b) {
   double largest = 0;
   for (int p = 0; p < gs::kParamCount; ++p) {
@@ -170,6 +176,17 @@ TEST_F(TrainerTest, TrainingIsAntialiasedWhateverTheStart) {
   classic.antialiased = false;
   const Trainer trainer(config(), setup(out.path()), classic);
   EXPECT_TRUE(trainer.model().antialiased);
+}
+
+// A start model's 3D filter belongs to other cameras (an LR model cloned for HR training).
+TEST_F(TrainerTest, StartModelsFilterIsRecomputedForTheseCameras) {
+  TempDir out;
+  gs::GaussianModel start = initial();
+  gs::update_filter_3d(start, cameras(setup(out.path())));
+  const torch::Tensor expected = start.filter_3d.clone();
+  start.filter_3d = expected * 4;
+  const Trainer trainer(config(), setup(out.path()), start);
+  EXPECT_TRUE(torch::allclose(trainer.model().filter_3d, expected));
 }
 
 }  // namespace
