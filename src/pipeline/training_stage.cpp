@@ -53,7 +53,10 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   }
   const bool resumable = stage_json(dir).value("params", nlohmann::json()) == identity &&
                          fs::exists(dir / "checkpoint.pt");
-  if (!resumable) fs::remove(dir / "train_log.csv");
+  if (!resumable) {  // an older run's checkpoint would be resumed by the next identical run
+    fs::remove(dir / "train_log.csv");
+    fs::remove(dir / "checkpoint.pt");
+  }
   record_stage(dir, identity, false, 0);
   train::Trainer trainer(config, std::move(setup), initial_model());
   if (resumable) {

@@ -1,0 +1,59 @@
+#include "pipeline/training_stage.hpp"
+
+#include <gtest/gtest.h>
+
+#include "io/atomic_file.hpp"
+#include "support/temp_dir.hpp"
+#include "synth/dataset_writer.hpp"
+#include "train/session.hpp"
+
+namespace iesrgs::pipeline {
+namespace {
+
+using testing::TempDir;
+
+struct StageRun {
+  train::TrainConfig config;
+  train::TrainerSetup setup;
+  Scene scene;
+};
+
+StageRun tiny_stage(const std::filesystem::path& dataset, const std::filesystem::path& out) {
+  synth::write_synth_dataset(dataset, {synth::SynthFormat::Blender, 16, 4, 1});
+  StageRun run{train::make_preset("fast", 3), {}, load_scene(dataset)};
+  run.config.checkpoint_every = 0;
+  run.config.test_every = 0;
+  run.config.init = "random";
+  run.config.random_points = 200;
+  ViewImages images(run.scene);
+  run.setup.train_views = train::load_views(run.scene, Split::Train, images);
+  run.setup.background = run.scene.background;
+  run.setup.scene_extent = run.scene.normalization().radius;
+  run.setup.output_dir = out;
+  return run;
+}
+
+// A run with new settings that dies before its first checkpoint must not leave the previous
+// settings' checkpoint for the next identical run to resume from.
+TEST(TrainingStage, NewSettingsNeverResumeAnOlderSettingsCheckpoint) {
+  TempDir dir;
+  const StageRun run = tiny_stage(dir / "scene", dir / "stage");
+  std::filesystem::create_directories(dir / "stage");
+  record_stage(dir / "stage", {{"old", "settings"}}, false, 0);
+  write_file_atomically(dir / "stage" / "checkpoint.pt", "older settings' checkpoint");
+
+  const auto killed_before_checkpoint = []() -> gs::GaussianModel {
+    throw std::runtime_error("killed");
+  };
+  EXPECT_THROW(run_training_stage("stage", {}, run.config, run.setup, killed_before_checkpoint),
+               std::runtime_error);
+  EXPECT_FALSE(std::filesystem::exists(dir / "stage" / "checkpoint.pt"));
+
+  const auto start = [&] { return train::initial_model(run.scene, run.config, {}); };
+  const StageResult result = run_training_stage("stage", {}, run.config, run.setup, start);
+  EXPECT_GT(result.model.size(), 0);
+  EXPECT_TRUE(training_stage_current(dir / "stage", {}, run.config));
+}
+
+}  // namespace
+}  // namespace iesrgs::pipeline
