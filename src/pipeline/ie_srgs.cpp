@@ -427,9 +427,9 @@ RunResult Pipeline::run() {
   const auto start = std::chrono::steady_clock::now();
   if (o_.only == StageSelection::Fusion) check_cached_inputs();
   if (o_.only != StageSelection::Internal) run_external_stages();
-  if (o_.only == StageSelection::External) return {{}, stages_};
+  if (o_.only == StageSelection::External) return {{}, stages_, {}};
   if (rows_use_internal_references() || o_.only == StageSelection::Internal) run_internal_stage();
-  if (o_.only == StageSelection::Internal) return {{}, stages_};
+  if (o_.only == StageSelection::Internal) return {{}, stages_, {}};
 
   RunResult result;
   for (const std::string& id : rows_) {
@@ -443,13 +443,15 @@ RunResult Pipeline::run() {
     internal.train_seconds = internal_->training.seconds;
     result.rows.push_back(internal);
   }
-  if (o_.only == StageSelection::All) keep_earlier_rows(result);
+  keep_earlier_rows(result);
   stages_["total_seconds_this_run"] = elapsed_since(start);
   result.stages = stages_;
+  result.evaluation = {{"test_views", test_digest_}, {"lpips", o_.lpips}};
   return result;
 }
 
 bool Pipeline::row_current(const RowSpec& row) const {
+  if (row.source == Source::HighRes && !hr_images_) return false;
   if (row_uses_internal(row) &&
       !internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
                               o_.output / "internal"))
@@ -460,10 +462,14 @@ bool Pipeline::row_current(const RowSpec& row) const {
 }
 
 // A rerun with fewer rows keeps the others of the folder's table, as long as their cached stage
-// is still the one these settings would reuse; rows trained under other settings are dropped, and
-// so are entries a damaged results.json garbled.
+// is still the one these settings would reuse and they were scored against the same test views;
+// rows trained under other settings are dropped, and so are entries a damaged results.json
+// garbled. An LPIPS taken with another network is left out.
 void Pipeline::keep_earlier_rows(RunResult& result) const {
   const nlohmann::json earlier = read_stage_record(o_.output / "results.json");
+  const nlohmann::json scored = earlier.value("evaluation", nlohmann::json());
+  if (!scored.is_object() || scored.value("test_views", nlohmann::json()) != test_digest_) return;
+  const bool same_lpips = scored.value("lpips", nlohmann::json()) == o_.lpips;
   const nlohmann::json rows = earlier.value("rows", nlohmann::json::array());
   for (const nlohmann::json& entry : rows.is_array() ? rows : nlohmann::json::array()) {
     try {
@@ -472,6 +478,7 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
           !row_current(*row))
         continue;
       result.rows.push_back(earlier_row(*row, row_label(*row), entry));
+      if (!same_lpips) result.rows.back().mean.lpips.reset();
     } catch (const nlohmann::json::exception&) {
       continue;
     }
@@ -502,7 +509,9 @@ std::string results_markdown(const RunResult& result) {
 }
 
 void write_results(const fs::path& dir, const RunResult& result) {
-  nlohmann::json json = {{"stages", result.stages}, {"rows", nlohmann::json::array()}};
+  nlohmann::json json = {{"stages", result.stages},
+                         {"evaluation", result.evaluation},
+                         {"rows", nlohmann::json::array()}};
   std::string csv = "row,label,psnr,ssim,lpips,train_seconds,fps\n";
   for (const RowResult& row : result.rows) {
     json["rows"].push_back(row_json(row));

@@ -58,7 +58,8 @@ struct RowResult {
 
 struct RunResult {
   std::vector<RowResult> rows;
-  nlohmann::json stages;  // seconds per stage
+  nlohmann::json stages;      // seconds per stage
+  nlohmann::json evaluation;  // what the rows were scored against: test views' digest, LPIPS net
 };
 
 // Runs the selected stages and writes <output>/results.{json,csv,md} after the rows, keeping the

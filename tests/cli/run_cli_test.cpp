@@ -71,8 +71,8 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
 
   // Rerunning one row keeps the rest of the folder's table.
   using Table = std::vector<std::pair<std::string, bool>>;
-  const std::string external_only =
-      "run " + scene + " -o " + out + " --rows external" + kTinySchedule;
+  const std::string external_args = scene + " -o " + out + " --rows external" + kTinySchedule;
+  const std::string external_only = "run " + external_args;
   const CliRun one = iesrgs(external_only);
   ASSERT_EQ(one.status, 0) << one.output;
   EXPECT_FALSE(contains(one.output, "it/s |")) << one.output;
@@ -88,8 +88,8 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
   EXPECT_EQ(table(), kept);
   EXPECT_TRUE(contains(read_file(dir / "run" / "results.md"), "from an earlier run"));
 
-  // Another internal model: the rows built on it leave the table, the others stay.
-  const CliRun other = iesrgs(external_only + " --internal-set seed=7");
+  // Another internal model: the rows built on it leave the table, the others stay (fuse too).
+  const CliRun other = iesrgs("fuse " + external_args + " --internal-set seed=7");
   ASSERT_EQ(other.status, 0) << other.output;
   const Table independent = {{"bicubic", true}, {"external", false}, {"hr", true}};
   EXPECT_EQ(table(), independent);
@@ -138,11 +138,14 @@ TEST(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
   TempDir dir;
   const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
   ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 5 --test-views 1 --seed 3").status, 0);
+  // The folder's earlier table, from a benchmark of the same images, has an hr row.
+  ASSERT_EQ(iesrgs("run " + scene + " -o " + out + " --rows hr" + kTinySchedule).status, 0);
   const CliRun run = iesrgs("run " + scene + " -o " + out + " --input-is-lr" + kTinySchedule);
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_EQ(read_image_header(dir / "run" / "rows/ie-srgs/test/rgb/r_0.png").width, 64);
   EXPECT_FALSE(std::filesystem::exists(dir / "run" / "rows/ie-srgs/test/metrics.json"));
   const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+  ASSERT_EQ(results["rows"].size(), 1u);
   EXPECT_FALSE(results["rows"][0].contains("psnr"));
 
   const CliRun hr =
@@ -170,6 +173,25 @@ TEST(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
                                       " --init internal --rows bicubic,internal" + kTinySchedule);
   ASSERT_EQ(after_bicubic.status, 0) << after_bicubic.output;
   EXPECT_EQ(internal_psnr(), alone);
+}
+
+// Earlier rows scored against test views that changed since leave the table, the internal-only
+// row too, though its model learnt from the unchanged training views.
+TEST(RunCli, RowsScoredAgainstOtherTestViewsLeaveTheTable) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 1 --seed 3").status, 0);
+  const std::string rows = "run " + scene + " -o " + out + " --rows ";
+  ASSERT_EQ(iesrgs(rows + "internal,bicubic" + kTinySchedule).status, 0);
+  const auto test_image = dir / "scene/test/r_0.png";
+  Image8 edited = read_image8(test_image);
+  for (uint8_t& value : edited.data) value = uint8_t(255 - value);
+  write_png(test_image, edited);
+  const CliRun again = iesrgs(rows + "bicubic" + kTinySchedule);
+  ASSERT_EQ(again.status, 0) << again.output;
+  const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+  ASSERT_EQ(results["rows"].size(), 1u) << results.dump();
+  EXPECT_EQ(results["rows"][0]["row"], "bicubic");
 }
 
 // Caches follow the images' content, not their folder: rewriting the same bytes (a copied
