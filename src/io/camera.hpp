@@ -38,7 +38,8 @@ struct Intrinsics {
 };
 
 struct Camera {
-  std::string name;  // image file stem, used to name renders after the ground truth
+  std::string name;  // image file stem (path below COLMAP's images/, '/' as '_'), unique per
+                     // split: renders and per-view outputs are named after it
   Split split = Split::Train;
   Intrinsics intrinsics;             // the pinhole model the renderer uses (after --downscale)
   Mat3 rotation;                     // world-to-camera

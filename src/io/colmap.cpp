@@ -168,7 +168,9 @@ Camera camera_of(const ColmapImage& image, const Lens& lens, const fs::path& roo
     fail_file(images_file,
               fmt::format("image '{}': rotation quaternion cannot be normalized", image.name));
   Camera camera;
-  camera.name = fs::path(image.name).stem().string();
+  // Rigs keep one folder per camera with the same file names in each: the folder stays in the name.
+  camera.name = fs::path(image.name).replace_extension().generic_string();
+  std::replace(camera.name.begin(), camera.name.end(), '/', '_');
   camera.image_path = root / "images" / image.name;
   camera.stored = lens.intrinsics;
   camera.intrinsics = lens.intrinsics;
@@ -205,8 +207,10 @@ Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
   const ColmapModel model = read_colmap_model(dir);
   const ModelFiles files(dir, stored_encoding(dir));
 
-  std::map<uint32_t, Lens> lenses;
-  for (const auto& [id, camera] : model.cameras) lenses[id] = lens_of(camera, files.cameras);
+  std::map<uint32_t, Lens> lenses;  // of the cameras images use: others may be any model
+  for (const auto& [id, image] : model.images)
+    if (!lenses.count(image.camera_id))
+      lenses[image.camera_id] = lens_of(model.cameras.at(image.camera_id), files.cameras);
 
   std::vector<const ColmapImage*> images;
   for (const auto& [id, image] : model.images) images.push_back(&image);

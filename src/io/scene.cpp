@@ -1,6 +1,9 @@
 #include "io/scene.hpp"
 
+#include <fmt/core.h>
+
 #include <algorithm>
+#include <map>
 
 #include "core/error.hpp"
 #include "io/colmap.hpp"
@@ -45,7 +48,26 @@ Scene read_any_format(const fs::path& root, const SceneOptions& options) {
   fail_file(root, "no scene found (looked for transforms_train.json, transforms.json, sparse/0/)");
 }
 
+void require_unique_names(const Scene& scene) {
+  std::map<std::pair<Split, std::string>, const Camera*> seen;
+  for (const Camera& camera : scene.cameras) {
+    const auto [it, added] = seen.emplace(std::pair(camera.split, camera.name), &camera);
+    if (!added)
+      fail_file(scene.root, fmt::format("images {} and {} are both {} views named '{}', and their "
+                                        "outputs would overwrite each other; rename one",
+                                        it->second->image_path.string(), camera.image_path.string(),
+                                        split_name(camera.split), camera.name));
+  }
+}
+
 }  // namespace
+
+void require_training_views(const Scene& scene) {
+  if (scene.split(Split::Train).empty())
+    fail_file(scene.root, fmt::format("no training views: all {} images are test views (COLMAP "
+                                      "scenes hold out every --test-every-th image)",
+                                      scene.cameras.size()));
+}
 
 Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   if (options.downscale < 1) fail("--downscale must be at least 1, got {}", options.downscale);
@@ -55,6 +77,7 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   Scene scene = read_any_format(root, options);
   if (scene.cameras.empty()) fail_file(root, "scene has no cameras");
   scene.root = root;
+  require_unique_names(scene);
   scene.background = options.background;
   scene.downscale = options.downscale;
   for (Camera& camera : scene.cameras)

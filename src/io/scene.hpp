@@ -43,7 +43,11 @@ struct SceneOptions {
 };
 
 // Detects the format from the files present and loads cameras and points (not the images).
-// Every camera's intrinsics are already at 1/downscale of the stored resolution.
+// Every camera's intrinsics are already at 1/downscale of the stored resolution. Throws Error
+// when two cameras of a split share a name, since their outputs would overwrite each other.
 Scene load_scene(const std::filesystem::path& root, const SceneOptions& options = {});
+
+// Throws Error naming the scene when it has no training view (every image held out for testing).
+void require_training_views(const Scene& scene);
 
 }  // namespace iesrgs

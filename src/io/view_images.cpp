@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdlib>
+#include <iterator>
 
 #include "core/error.hpp"
 #include "io/file_digest.hpp"
@@ -19,13 +20,16 @@ std::string describe(const Intrinsics& k) {
   return fmt::format("{}x{}", k.width, k.height);
 }
 
-// The pre-downscaled copy "<dir>_<k>/<file>" (COLMAP / nerfstudio convention), if present.
-fs::path downscaled_copy(const fs::path& image_path, int downscale) {
+// The pre-downscaled copy, if present: the image's top folder below the scene root gets "_<k>"
+// (COLMAP / nerfstudio convention: images/cam0/a.png -> images_2/cam0/a.png).
+fs::path downscaled_copy(const fs::path& root, const fs::path& image_path, int downscale) {
   if (downscale <= 1) return {};
-  const fs::path dir = image_path.parent_path();
-  const fs::path candidate = dir.parent_path() /
-                             (dir.filename().string() + "_" + std::to_string(downscale)) /
-                             image_path.filename();
+  const fs::path relative = image_path.lexically_relative(root);
+  if (relative.empty() || *relative.begin() == ".." ||
+      std::next(relative.begin()) == relative.end())
+    return {};  // not inside a folder of the scene
+  fs::path candidate = root / (relative.begin()->string() + "_" + std::to_string(downscale));
+  for (auto part = std::next(relative.begin()); part != relative.end(); ++part) candidate /= *part;
   std::error_code ec;
   return fs::is_regular_file(candidate, ec) ? candidate : fs::path{};
 }
@@ -99,7 +103,7 @@ Image8 ViewImages::undistorted(const Camera& camera, const Image8& source,
 }
 
 fs::path ViewImages::source_path(const Camera& camera) const {
-  const fs::path copy = downscaled_copy(camera.image_path, scene_.downscale);
+  const fs::path copy = downscaled_copy(scene_.root, camera.image_path, scene_.downscale);
   return copy.empty() ? camera.image_path : copy;
 }
 

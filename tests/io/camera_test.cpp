@@ -1,7 +1,6 @@
 #include <gtest/gtest.h>
 
 #include "io/camera.hpp"
-#include "io/scene.hpp"
 
 namespace iesrgs {
 namespace {
@@ -60,19 +59,6 @@ TEST(Camera, DistortionModelMatchesOpenCv) {
   EXPECT_NEAR(xd, 0.3 * radial + 2 * 0.001 * 0.3 * -0.2 + -0.002 * (r2 + 2 * 0.09), 1e-15);
   EXPECT_NEAR(yd, -0.2 * radial + 0.001 * (r2 + 2 * 0.04) + 2 * -0.002 * 0.3 * -0.2, 1e-15);
   EXPECT_FALSE(Distortion{}.any());
-}
-
-TEST(Scene, NormalizationAsGaussianSplatting) {
-  Scene scene;
-  for (double x : {-2.0, 0.0, 4.0}) {
-    Camera camera;
-    camera.translation = {-x, 0, 0};  // identity rotation: center = (x, 0, 0)
-    scene.cameras.push_back(camera);
-  }
-  scene.cameras.back().split = Split::Test;  // test cameras do not count
-  const SceneNormalization norm = scene.normalization();
-  EXPECT_NEAR(norm.center.x, -1, 1e-12);
-  EXPECT_NEAR(norm.radius, 1.1, 1e-12);
 }
 
 }  // namespace

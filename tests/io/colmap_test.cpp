@@ -275,7 +275,7 @@ TEST(Colmap, SceneCamerasFollowTheModel) {
     if (camera.split == Split::Test) test_names.push_back(camera.name);
   }
   EXPECT_EQ(names, (std::vector<std::string>{"frame_a", "frame_b", "frame_c", "frame_d", "frame_e",
-                                             "frame_f"}));
+                                             "left cam_frame_f"}));
   EXPECT_EQ(test_names, (std::vector<std::string>{"frame_a", "frame_c", "frame_e"}));
 
   const Camera& c = camera_named(scene, "frame_c");  // R = 90 deg about z, t = (1, 2, 3)
@@ -319,7 +319,8 @@ TEST(Colmap, SceneCamerasFollowTheModel) {
   EXPECT_EQ(d.distortion.p1, 0.001);
   EXPECT_EQ(d.distortion.p2, -0.002);
 
-  EXPECT_EQ(camera_named(scene, "frame_f").image_path, root / "images" / "left cam/frame_f.png");
+  EXPECT_EQ(camera_named(scene, "left cam_frame_f").image_path,
+            root / "images" / "left cam/frame_f.png");
   for (const Camera& camera : scene.cameras) {
     EXPECT_EQ(camera.intrinsics.fx, camera.stored.fx);
     EXPECT_EQ(camera.intrinsics.width, camera.stored.width);
@@ -467,6 +468,14 @@ TEST(Colmap, UnsupportedCameraModelIsNamed) {
   expect_error([&] { load_scene(root.path()); },
                {(root / "sparse/0/cameras.txt").string(), "OPENCV_FISHEYE",
                 "SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV"});
+}
+
+TEST(Colmap, UnusedCameraOfAnyModelIsIgnored) {
+  TempDir root;
+  ColmapModel model = sample_model();
+  model.cameras[9] = {9, "OPENCV_FISHEYE", 100, 100, {1, 1, 50, 50, 0, 0, 0, 0}};
+  write_colmap_model_text(root / "sparse/0", model);
+  EXPECT_EQ(load_scene(root.path()).cameras.size(), model.images.size());
 }
 
 TEST(Colmap, ImageWithMissingCameraIsRefused) {

@@ -31,7 +31,10 @@ struct SceneFixture {
   Scene scene;
   ViewImageOptions options;
 
-  SceneFixture() { options.undistort_cache_dir = dir / "cache"; }
+  SceneFixture() {
+    scene.root = dir.path();
+    options.undistort_cache_dir = dir / "cache";
+  }
   const Camera& add(const std::string& name, const Image8& image) {
     write_png(dir / "images" / name, image);
     scene.cameras.push_back(camera_for(dir / "images" / name, image.width, image.height));
@@ -61,6 +64,17 @@ TEST(ViewImages, PrefersThePreDownscaledFolder) {
   const auto rgb = images.rgb(camera);
   EXPECT_EQ(rgb->width, 4);
   EXPECT_FLOAT_EQ(rgb->at(1, 1, 1), 1.f);  // green: the downscaled copy, not the original
+}
+
+// A rig's images/cam0/a.png has its copy in images_2/cam0/a.png.
+TEST(ViewImages, FindsThePreDownscaledCopyOfANestedImage) {
+  SceneFixture f;
+  Camera camera = f.add("cam0/a.png", solid(8, 8, {255, 0, 0}));
+  write_png(f.dir / "images_2" / "cam0" / "a.png", solid(4, 4, {0, 255, 0}));
+  f.scene.downscale = 2;
+  camera.intrinsics = camera.stored.scaled(0.5);
+  ViewImages images(f.scene, f.options);
+  EXPECT_FLOAT_EQ(images.rgb(camera)->at(1, 1, 1), 1.f);
 }
 
 TEST(ViewImages, ResizesWhenNoDownscaledCopyExists) {

@@ -1,0 +1,64 @@
+#include "io/scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "io/atomic_file.hpp"
+#include "support/expect_error.hpp"
+#include "support/temp_dir.hpp"
+#include "synth/dataset_writer.hpp"
+
+namespace iesrgs {
+namespace {
+
+using testing::contains;
+using testing::error_message;
+using testing::TempDir;
+
+TEST(Scene, NormalizationAsGaussianSplatting) {
+  Scene scene;
+  for (double x : {-2.0, 0.0, 4.0}) {
+    Camera camera;
+    camera.translation = {-x, 0, 0};  // identity rotation: center = (x, 0, 0)
+    scene.cameras.push_back(camera);
+  }
+  scene.cameras.back().split = Split::Test;  // test cameras do not count
+  const SceneNormalization norm = scene.normalization();
+  EXPECT_NEAR(norm.center.x, -1, 1e-12);
+  EXPECT_NEAR(norm.radius, 1.1, 1e-12);
+}
+
+TEST(Scene, TwoViewsOfASplitWithOneNameAreRefused) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 3, 1});
+  const auto json_path = dir / "scene" / "transforms_train.json";
+  nlohmann::json transforms = nlohmann::json::parse(read_file(json_path));
+  transforms["frames"][1]["file_path"] = "./test/r_0";  // a second train view named r_0
+  write_file_atomically(json_path, transforms.dump());
+  const std::string message = error_message([&] { load_scene(dir / "scene"); });
+  EXPECT_TRUE(contains(message, "train views named 'r_0'")) << message;
+  EXPECT_TRUE(contains(message, "test/r_0.png")) << message;
+}
+
+TEST(Scene, ViewsOfDifferentSplitsMayShareAName) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 2});
+  const Scene scene = load_scene(dir / "scene");
+  EXPECT_EQ(scene.split(Split::Train)[0]->name, scene.split(Split::Test)[0]->name);
+  require_training_views(scene);
+}
+
+TEST(Scene, ASceneWithoutTrainingViewsNamesItself) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Colmap, 8, 3, 0});
+  SceneOptions every_view_held_out;
+  every_view_held_out.test_every = 1;
+  const Scene scene = load_scene(dir / "scene", every_view_held_out);
+  const std::string message = error_message([&] { require_training_views(scene); });
+  EXPECT_TRUE(contains(message, "no training views: all 3 images are test views")) << message;
+  EXPECT_TRUE(contains(message, (dir / "scene").string())) << message;
+}
+
+}  // namespace
+}  // namespace iesrgs
