@@ -89,6 +89,9 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
       depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights);
       loaded = true;
     }
+    // Forget the view's old entry first: a run killed between the writes below must not leave
+    // new files under it, which a later run with the old settings would take for its own.
+    if (record.erase(camera.name)) write_file_atomically(record_path, record.dump(1) + "\n");
     const torch::Tensor upscaled =
         priors::sr::upscale_tiled(*sr, to_tensor(*images.rgb(camera)), options.tiles);
     write_png(view.image, to_image8(upscaled));
