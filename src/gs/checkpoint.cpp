@@ -78,7 +78,8 @@ void load_training_state(const std::filesystem::path& path, GaussianModel& model
     DensifyStats loaded_stats;
     loaded_stats.load(archive, loaded_model.size());
     if (extras)
-      for (auto& [name, value] : *extras) archive.read("extra/" + name, value);
+      for (auto& [name, value] : *extras)
+        if (!archive.try_read("extra/" + name, value)) value = torch::Tensor();
     model = std::move(loaded_model);
     optimizer = std::move(loaded_optimizer);
     stats = std::move(loaded_stats);

@@ -21,7 +21,8 @@ void save_training_state(const std::filesystem::path& path, const GaussianModel&
 
 // Replaces all three with the stored state, bit for bit; the optimizer keeps its learning-rate
 // settings. Throws Error naming the file when it is unreadable or inconsistent.
-// `extras` gets every extra stored under the names it already holds; a missing one is an error.
+// `extras` gets every extra stored under the names it already holds; a missing one is left
+// undefined.
 void load_training_state(const std::filesystem::path& path, GaussianModel& model,
                          GaussianOptimizer& optimizer, DensifyStats& stats,
                          CheckpointExtras* extras = nullptr);

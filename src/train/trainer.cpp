@@ -93,8 +93,9 @@ std::filesystem::path Trainer::checkpoint_path() const {
   return setup_.output_dir / "checkpoint.pt";
 }
 
-void Trainer::save_checkpoint() {
-  if (!all_finite(model_)) return;  // never replace a good checkpoint with a broken model
+void Trainer::save_checkpoint(double loss) {
+  // Never replace a good checkpoint with a broken model.
+  if (!all_finite(model_)) fail_diverged(iteration_, loss);
   std::ostringstream view_rng;
   view_rng << view_rng_;
   torch::Tensor torch_rng;
@@ -106,7 +107,8 @@ void Trainer::save_checkpoint() {
   gs::save_training_state(checkpoint_path(), model_, *optimizer_, stats_,
                           {{"iteration", torch::tensor(iteration_)},
                            {"view_rng", bytes_tensor(view_rng.str())},
-                           {"torch_rng", torch_rng}});
+                           {"torch_rng", torch_rng},
+                           {"seconds", torch::tensor(training_seconds(), torch::kFloat64)}});
   checkpoint_iteration_ = iteration_;
 }
 
@@ -114,9 +116,14 @@ void Trainer::resume() {
   const std::filesystem::path path = checkpoint_path();
   if (!std::filesystem::exists(path))
     fail_file(path, "no checkpoint to resume from (train without --resume first)");
-  gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}}};
+  gs::CheckpointExtras extras{
+      {"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}}, {"seconds", {}}};
   gs::load_training_state(path, model_, *optimizer_, stats_, &extras);
+  for (const char* required : {"iteration", "view_rng", "torch_rng"})
+    if (!extras[required].defined())
+      fail_file(path, fmt::format("not a training checkpoint of iesrgs train (no {})", required));
   iteration_ = extras["iteration"].item<int64_t>();
+  seconds_before_ = extras["seconds"].defined() ? extras["seconds"].item<double>() : 0;
   std::istringstream view_rng(tensor_bytes(extras["view_rng"]));
   view_rng >> view_rng_;
   if (!view_rng) fail_file(path, "the stored view sampler state is corrupt");
@@ -201,6 +208,11 @@ void Trainer::fail_diverged(int64_t iteration, double loss) const {
       iteration, std::isfinite(loss) ? "parameters" : "loss", loss, kept);
 }
 
+double Trainer::training_seconds() const {
+  return seconds_before_ +
+         std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start_).count();
+}
+
 double Trainer::evaluate_psnr(const std::vector<TrainView>& views) const {
   torch::NoGradGuard no_grad;
   double sum = 0;
@@ -228,7 +240,7 @@ TrainSummary Trainer::run() {
   std::vector<Camera> cameras;
   for (const TrainView& view : setup_.train_views) cameras.push_back(view.camera);
   write_cameras_json(setup_.output_dir / "cameras.json", cameras);
-  const auto start = std::chrono::steady_clock::now();
+  run_start_ = std::chrono::steady_clock::now();
   const int64_t first = iteration_;
   double loss = 0;
   while (iteration_ < config_.iterations) {
@@ -250,7 +262,7 @@ TrainSummary Trainer::run() {
     const bool interrupted = interrupt_requested.load();
     if (last || interrupted ||
         (config_.checkpoint_every > 0 && iteration_ % config_.checkpoint_every == 0))
-      save_checkpoint();
+      save_checkpoint(loss);
     if (interrupted) {
       fmt::print("interrupted: checkpoint of iteration {} saved to {}; continue with --resume\n",
                  iteration_, checkpoint_path().string());
@@ -258,10 +270,10 @@ TrainSummary Trainer::run() {
       break;
     }
   }
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds = training_seconds();
   summary.iterations = iteration_;
-  summary.iterations_per_second =
-      summary.seconds > 0 ? double(iteration_ - first) / summary.seconds : 0;
+  const double this_run = summary.seconds - seconds_before_;
+  summary.iterations_per_second = this_run > 0 ? double(iteration_ - first) / this_run : 0;
   summary.final_loss = loss;
   summary.gaussians = model_.size();
   return summary;

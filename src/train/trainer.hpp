@@ -5,6 +5,7 @@
 #include <torch/types.h>
 
 #include <array>
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -39,7 +40,7 @@ struct TrainerSetup {
 struct TrainSummary {
   int64_t iterations = 0;    // completed in total (including before a resume)
   bool interrupted = false;  // stopped by SIGINT after saving a checkpoint
-  double seconds = 0;        // of this process's training
+  double seconds = 0;        // of training, the runs before a resume included
   double iterations_per_second = 0;
   double final_loss = 0;
   double test_psnr = 0;  // last report; 0 without test views
@@ -69,9 +70,10 @@ class Trainer {
   double step(int64_t iteration);  // one optimizer step; returns the loss
   std::vector<int> pick_views();
   void densify(int64_t iteration);
-  void save_checkpoint();
+  void save_checkpoint(double loss);  // of the last step, for the error when diverged
   [[noreturn]] void fail_diverged(int64_t iteration, double loss) const;
   double report_test_psnr();
+  double training_seconds() const;
 
   TrainConfig config_;
   TrainerSetup setup_;
@@ -82,6 +84,8 @@ class Trainer {
   std::mt19937_64 view_rng_;
   int64_t iteration_ = 0;              // completed iterations
   int64_t checkpoint_iteration_ = -1;  // of the last checkpoint written or read
+  double seconds_before_ = 0;          // training time of the runs before a resume
+  std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now();
 };
 
 }  // namespace iesrgs::train

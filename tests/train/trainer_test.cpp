@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <chrono>
 #include <csignal>
 #include <limits>
+#include <thread>
 
 #include "io/ply.hpp"
 #include "loss/autograd.hpp"
@@ -105,7 +107,10 @@ TEST_F(TrainerTest, InterruptedRunResumesToTheSameModel) {
   TrainerSetup s = setup(resumed_dir.path());
   int calls = 0;
   const ViewLoss photometric = [&](int view, const raster::RenderOutput& render) {
-    if (++calls == 17 * 3) std::raise(SIGINT);
+    if (++calls == 17 * 3) {
+      std::this_thread::sleep_for(std::chrono::seconds(1));  // a first run of at least 1 s
+      std::raise(SIGINT);
+    }
     const torch::Tensor& target = s.train_views[size_t(view)].target;
     return 0.8 * (render.image - target).abs().mean() +
            0.2 * (1 - loss::ssim_autograd(render.image, target).mean);
@@ -119,8 +124,12 @@ TEST_F(TrainerTest, InterruptedRunResumesToTheSameModel) {
 
   Trainer second(config(), s, initial());
   second.resume();
-  EXPECT_EQ(second.run().iterations, 40);
+  const auto start = std::chrono::steady_clock::now();
+  const TrainSummary resumed = second.run();
+  const std::chrono::duration<double> second_run = std::chrono::steady_clock::now() - start;
+  EXPECT_EQ(resumed.iterations, 40);
   EXPECT_EQ(max_difference(second.model(), straight.model()), 0.0);
+  EXPECT_GT(resumed.seconds, second_run.count() + 0.9);  // both runs' training time
 }
 
 TEST_F(TrainerTest, NonFiniteLossStopsWithTheCheckpointNamed) {
@@ -150,6 +159,18 @@ TEST_F(TrainerTest, NonFiniteParametersStopTrainingBeforeItEnds) {
   Trainer trainer(c, setup(out.path()), initial());
   const std::string message = error_message([&] { trainer.run(); });
   EXPECT_NE(message.find("training diverged at iteration"), std::string::npos) << message;
+}
+
+// A checkpoint due on a broken model stops the run there rather than skipping the write.
+TEST_F(TrainerTest, NonFiniteParametersStopAtTheNextCheckpoint) {
+  TempDir out;
+  TrainConfig c = config();
+  c.learning_rates.opacity = 1e39;
+  c.checkpoint_every = 5;
+  Trainer trainer(c, setup(out.path()), initial());
+  const std::string message = error_message([&] { trainer.run(); });
+  EXPECT_NE(message.find("diverged at iteration 5:"), std::string::npos) << message;
+  EXPECT_NE(message.find("no checkpoint was written yet"), std::string::npos) << message;
 }
 
 TEST_F(TrainerTest, ResumeWithoutCheckpointIsAClearError) {
