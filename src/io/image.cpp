@@ -146,6 +146,9 @@ void write_png(const fs::path& path, const Image& image) {
 }
 
 void write_png16(const fs::path& path, const std::vector<uint16_t>& gray, int width, int height) {
+  if (width < 1 || height < 1 || gray.size() != size_t(width) * size_t(height))
+    fail_file(path, fmt::format("cannot write {} samples as a {}x{} gray PNG", gray.size(), width,
+                                height));
   std::vector<uint8_t> big_endian(gray.size() * 2);
   for (size_t i = 0; i < gray.size(); ++i) {
     big_endian[2 * i] = uint8_t(gray[i] >> 8);

@@ -64,6 +64,14 @@ TEST(Image, Png16IsReadBackExactly) {
   stbi_image_free(pixels);
 }
 
+TEST(Image, Png16OfTheWrongSampleCountIsRefused) {
+  TempDir dir;
+  const std::string message =
+      error_message([&] { write_png16(dir / "d.png", std::vector<uint16_t>(5), 3, 2); });
+  EXPECT_NE(message.find("cannot write 5 samples as a 3x2 gray PNG"), std::string::npos) << message;
+  EXPECT_FALSE(std::filesystem::exists(dir / "d.png"));
+}
+
 TEST(Image, ToEightBitRoundsAndClamps) {
   Image image(4, 1, 1);
   image.data = {-0.5f, 0.5f, 1.5f, 0.2f};
