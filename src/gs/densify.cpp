@@ -89,9 +89,9 @@ Tensor mean_gradient(const DensifyStats& stats, GradientSource source) {
 Tensor prune_mask(const GaussianModel& model, const DensifyStats& stats,
                   const DensifyOptions& options, double scene_extent) {
   Tensor mask = torch::sigmoid(model.opacity_logits.detach()) < options.min_opacity;
-  if (options.max_screen_size > 0)
-    mask = mask | (stats.max_radii > options.max_screen_size) |
-           (max_scale(model) > 0.1 * scene_extent);
+  if (options.max_screen_size > 0) mask = mask | (stats.max_radii > options.max_screen_size);
+  if (options.max_world_size > 0)
+    mask = mask | (max_scale(model) > options.max_world_size * scene_extent);
   return mask;
 }
 

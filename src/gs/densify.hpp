@@ -27,7 +27,8 @@ struct DensifyOptions {
   GradientSource source = GradientSource::Viewspace;  // Absolute: GOF-style absolute gradients
   double percent_dense = 0.01;  // clone below, split above this fraction of the extent
   double min_opacity = 0.005;
-  float max_screen_size = 0;  // pixels; 0 disables the screen- and world-size pruning
+  float max_screen_size = 0;  // prune splats drawn larger (max radius, pixels); 0: off
+  double max_world_size = 0;  // prune splats larger than this x the extent; 0: off
 };
 
 // Per-Gaussian accumulators between two densification steps, as 3DGS's xyz_gradient_accum,

@@ -31,6 +31,7 @@ void visit_fields(Config& c, Visit&& visit) {
   visit("percent_dense", c.percent_dense);
   visit("min_opacity", c.min_opacity);
   visit("max_screen_size", c.max_screen_size);
+  visit("max_world_size", c.max_world_size);
   visit("filter_update_every", c.filter_update_every);
   visit("lr_position_initial", c.learning_rates.position_initial);
   visit("lr_position_final", c.learning_rates.position_final);
@@ -87,11 +88,10 @@ TrainConfig make_preset(const std::string& name, int64_t iterations) {
     fail("unknown preset \"{}\" (known: paper, cpu, fast)", name);
   }
   // 3DGS prunes large Gaussians from its first opacity reset on, when 25 densification steps
-  // have split the model into small splats. A shortened schedule resets after a few steps, and
-  // the 20-pixel rule then deletes most of a model still made of large splats (84 % of lego's at
-  // 800x800), so short presets leave that pruning off, as 3DGS before its first reset and gsplat
-  // by default do.
-  if (name != "paper") config.max_screen_size = 0;
+  // have split the model into small splats. A shortened schedule resets after a few steps, when
+  // the model is still made of large splats (a 20-pixel rule deleted 84 % of lego's at 800x800),
+  // so short presets leave that pruning off, as 3DGS does before its first reset.
+  if (name != "paper") config.max_world_size = 0;
   if (iterations > 0) rescale_schedule(config, iterations);
   return config;
 }

@@ -28,7 +28,11 @@ struct TrainConfig {
   bool absolute_gradients = false;
   double percent_dense = 0.01;
   double min_opacity = 0.005;
-  float max_screen_size = 20;  // pixels, after the first opacity reset; 0: no large-splat pruning
+  // Large-splat pruning after the first opacity reset; 0: off. 3DGS and Mip-Splatting pass a
+  // 20-pixel limit too, but zero the radii it tests before testing them: only the world-size
+  // rule prunes there, so that is the default.
+  float max_screen_size = 0;          // pixels
+  double max_world_size = 0.1;        // x the scene extent
   int64_t filter_update_every = 100;  // Mip-Splatting 3D filter, once densification has stopped
 
   gs::LearningRates learning_rates;

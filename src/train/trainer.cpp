@@ -183,7 +183,9 @@ void Trainer::densify(int64_t iteration) {
           c.absolute_gradients ? gs::GradientSource::Absolute : gs::GradientSource::Viewspace;
       options.percent_dense = c.percent_dense;
       options.min_opacity = c.min_opacity;
-      options.max_screen_size = iteration > c.opacity_reset_every ? c.max_screen_size : 0;
+      const bool after_reset = iteration > c.opacity_reset_every;
+      options.max_screen_size = after_reset ? c.max_screen_size : 0;
+      options.max_world_size = after_reset ? c.max_world_size : 0;
       gs::densify_and_prune(model_, *optimizer_, stats_, options, setup_.scene_extent);
       gs::update_filter_3d(model_, train_cameras_);
     }

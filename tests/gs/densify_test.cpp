@@ -169,8 +169,14 @@ TEST(Densify, PrunesOversizedGaussiansOnlyWhenEnabled) {
   DensifyOptions options;
   EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).pruned, 0);
   stats.accumulate({view({0, 0, 0}, {5, 30, 5})});
+  options.max_world_size = 0.1;
+  EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).pruned, 1);
+  ASSERT_EQ(m.size(), 2);
+  EXPECT_EQ(m.means[1][0].item<float>(), 1.f);  // the 30-pixel one stays
+  stats = DensifyStats::zeros(2);
+  stats.accumulate({view({0, 0}, {5, 30})});
   options.max_screen_size = 20;
-  EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).pruned, 2);
+  EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).pruned, 1);
   ASSERT_EQ(m.size(), 1);
   EXPECT_EQ(m.means[0][0].item<float>(), 0.f);
 }

@@ -21,7 +21,8 @@ TEST(TrainConfig, PaperPresetIsMethodSchedule) {
   EXPECT_EQ(c.sh_increase_every, 1000);
   EXPECT_DOUBLE_EQ(c.grad_threshold, 2e-4);
   EXPECT_EQ(c.learning_rates.position_max_steps, 30000);
-  EXPECT_EQ(c.max_screen_size, 20);
+  EXPECT_EQ(c.max_screen_size, 0);  // dead in 3DGS (see config.hpp)
+  EXPECT_EQ(c.max_world_size, 0.1);
 }
 
 TEST(TrainConfig, ShorterRunsScaleTheScheduleTogether) {
@@ -36,9 +37,9 @@ TEST(TrainConfig, ShorterRunsScaleTheScheduleTogether) {
   EXPECT_EQ(make_preset("cpu").iterations, 10000);
   EXPECT_EQ(make_preset("fast").iterations, 3000);
   // Short presets prune no large splats (see make_preset); --iterations alone keeps 3DGS's rule.
-  EXPECT_EQ(make_preset("cpu").max_screen_size, 0);
-  EXPECT_EQ(make_preset("fast", 500).max_screen_size, 0);
-  EXPECT_EQ(c.max_screen_size, 20);
+  EXPECT_EQ(make_preset("cpu").max_world_size, 0);
+  EXPECT_EQ(make_preset("fast", 500).max_world_size, 0);
+  EXPECT_EQ(c.max_world_size, 0.1);
 }
 
 TEST(TrainConfig, JsonRoundTripsEveryField) {
