@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 #include <string>
 
 #include "core/byte_reader.hpp"
@@ -340,6 +341,8 @@ SplatCloud parse_spz(std::string_view bytes, const std::filesystem::path& name) 
     return decode_streams(header, streams);
   } catch (const FormatError& e) {
     fail_file(name, e.what());
+  } catch (const std::bad_alloc&) {  // sizes up to 1024x the file's pass the checks above
+    fail_file(name, "not enough memory to decode it");
   }
 }
 
