@@ -444,10 +444,10 @@ RunResult Pipeline::run() {
     internal.train_seconds = internal_->training.seconds;
     result.rows.push_back(internal);
   }
+  result.evaluation = {{"test_views", test_digest_}, {"lpips", o_.lpips}};
   keep_earlier_rows(result);
   stages_["total_seconds_this_run"] = elapsed_since(start);
   result.stages = stages_;
-  result.evaluation = {{"test_views", test_digest_}, {"lpips", o_.lpips}};
   return result;
 }
 
@@ -469,8 +469,11 @@ bool Pipeline::row_current(const RowSpec& row) const {
 void Pipeline::keep_earlier_rows(RunResult& result) const {
   const nlohmann::json earlier = read_stage_record(o_.output / "results.json");
   const nlohmann::json scored = earlier.value("evaluation", nlohmann::json());
-  if (!scored.is_object() || scored.value("test_views", nlohmann::json()) != test_digest_) return;
-  const bool same_lpips = scored.value("lpips", nlohmann::json()) == o_.lpips;
+  const auto same = [&](const char* key) {
+    return scored.is_object() && scored.value(key, nlohmann::json()) == result.evaluation[key];
+  };
+  if (!same("test_views")) return;
+  const bool same_lpips = same("lpips");
   const nlohmann::json rows = earlier.value("rows", nlohmann::json::array());
   for (const nlohmann::json& entry : rows.is_array() ? rows : nlohmann::json::array()) {
     try {

@@ -239,9 +239,7 @@ TrainSummary Trainer::run() {
   InterruptScope interrupt_scope;
   TrainSummary summary;
   ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations);
-  std::vector<Camera> cameras;
-  for (const TrainView& view : setup_.train_views) cameras.push_back(view.camera);
-  write_cameras_json(setup_.output_dir / "cameras.json", cameras);
+  write_cameras_json(setup_.output_dir / "cameras.json", train_cameras_);
   run_start_ = std::chrono::steady_clock::now();
   const int64_t first = iteration_;
   double loss = 0;
