@@ -19,10 +19,14 @@ scripts/apt-install.sh "${PACKAGES[@]}"
 
 # The default super-resolution prior: the MIT-licensed pre-trained ESRGAN models of UpscalerJS
 # (TensorFlow.js layers models), looked up at run time in $IESRGS_NPM_DIR or third_party/npm.
-if [ ! -f third_party/npm/node_modules/@upscalerjs/esrgan-slim/models/x4/model.json ]; then
-  npm install --prefix third_party/npm --no-save --omit=peer --no-audit --no-fund \
-    @upscalerjs/esrgan-slim@1.0.0
-fi
+# Thick (115 MB) is the one `--sr-model auto` uses; slim (4 MB) is checked against TensorFlow.js.
+for variant in thick slim; do
+  if [ ! -f "third_party/npm/node_modules/@upscalerjs/esrgan-$variant/models/x4/model.json" ]; then
+    npm install --prefix third_party/npm --no-save --omit=peer --no-audit --no-fund \
+      @upscalerjs/esrgan-thick@1.0.0 @upscalerjs/esrgan-slim@1.0.0
+    break
+  fi
+done
 
 build_dir=build
 options=(-DCMAKE_BUILD_TYPE=Release)

@@ -64,13 +64,14 @@ fs::path npm_dir() {
   return dir && *dir ? fs::path(dir) : fs::path(IESRGS_DEFAULT_NPM_DIR);
 }
 
-// Setup installs only the slim package, so the others need the npm command spelled out; the
-// loader was checked against the 1.0.0 packages.
+// Setup installs the thick package (the default prior) and the slim one (whose outputs the tests
+// check against TensorFlow.js'), so medium needs the npm command spelled out; the loader was
+// checked against the 1.0.0 packages.
 std::string install_hint(const std::string& name, bool default_location) {
   if (!default_location) return fmt::format("the folder is not an @upscalerjs/{} package", name);
   return fmt::format("npm install --prefix {} @upscalerjs/{}@1.0.0 installs it{}",
                      npm_dir().string(), name,
-                     name == "esrgan-slim" ? ", and so does scripts/setup.sh" : "");
+                     name == "esrgan-medium" ? "" : ", and so does scripts/setup.sh");
 }
 
 }  // namespace

@@ -22,7 +22,8 @@ std::filesystem::path esrgan_model_dir(const std::string& variant, int scale,
                                        const std::filesystem::path& package_dir);
 
 // <npm dir>/node_modules/@upscalerjs/esrgan-<variant>, where <npm dir> is $IESRGS_NPM_DIR or, when
-// that is unset, third_party/npm in the source tree (scripts/setup.sh installs esrgan-slim there).
+// that is unset, third_party/npm in the source tree (scripts/setup.sh installs esrgan-thick and
+// esrgan-slim there).
 std::filesystem::path default_esrgan_package_dir(const std::string& variant);
 
 }  // namespace iesrgs::priors::sr

@@ -149,7 +149,9 @@ std::unique_ptr<SrNet> make_sr_net(const std::string& model, const fs::path& wei
 
 std::string auto_sr_model(int scale) {
   if (fs::exists(default_sr_weights("safmn", scale))) return "safmn";
-  if (fs::exists(esrgan_model_dir("slim", scale, {}) / "model.json")) return "esrgan-slim";
+  for (const char* variant : {"thick", "slim"})
+    if (fs::exists(esrgan_model_dir(variant, scale, {}) / "model.json"))
+      return std::string("esrgan-") + variant;
   return "bicubic";
 }
 

@@ -16,7 +16,7 @@ std::filesystem::path default_weights_dir();
 std::filesystem::path default_sr_weights(const std::string& model, int scale);
 
 // The best prior at hand for `scale`, for "--sr-model auto": SAFMN when its checkpoint is at
-// the default location, else the installed ESRGAN (slim) package, else bicubic.
+// the default location, else the best installed ESRGAN package (thick, then slim), else bicubic.
 std::string auto_sr_model(int scale);
 
 // The names make_sr_net accepts.

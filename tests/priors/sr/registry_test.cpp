@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 
+#include "io/atomic_file.hpp"
 #include "priors/sr/sr_test_support.hpp"
 #include "support/expect_error.hpp"
 #include "support/scoped_env.hpp"
@@ -44,6 +45,24 @@ TEST(SrRegistry, DefaultWeightsFollowTheEnvironment) {
 TEST(SrRegistry, DefaultWeightsAreTheDevelopmentDataOtherwise) {
   ScopedEnv weights("IESRGS_WEIGHTS_DIR", std::nullopt);
   EXPECT_EQ(default_weights_dir(), std::filesystem::path(IESRGS_SHARED_DATA) / "weights");
+}
+
+TEST(SrRegistry, AutoPicksSafmnThenTheBestInstalledEsrganThenBicubic) {
+  TempDir weights_dir, npm_dir;
+  ScopedEnv weights("IESRGS_WEIGHTS_DIR", weights_dir.path().string());
+  ScopedEnv npm("IESRGS_NPM_DIR", npm_dir.path().string());
+  const auto install = [](const std::filesystem::path& file) {
+    std::filesystem::create_directories(file.parent_path());
+    write_file_atomically(file, "{}");
+  };
+  EXPECT_EQ(auto_sr_model(4), "bicubic");
+  install(npm_dir / "node_modules/@upscalerjs/esrgan-slim/models/x4/model.json");
+  EXPECT_EQ(auto_sr_model(4), "esrgan-slim");
+  install(npm_dir / "node_modules/@upscalerjs/esrgan-thick/models/x4/model.json");
+  EXPECT_EQ(auto_sr_model(4), "esrgan-thick");
+  EXPECT_EQ(auto_sr_model(2), "bicubic");
+  install(weights_dir / "sr/SAFMN_x4.pth");
+  EXPECT_EQ(auto_sr_model(4), "safmn");
 }
 
 TEST(SrRegistry, MissingDefaultWeightsSayWhereTheyWereLookedFor) {
