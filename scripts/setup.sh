@@ -19,14 +19,15 @@ scripts/apt-install.sh "${PACKAGES[@]}"
 
 # The default super-resolution prior: the MIT-licensed pre-trained ESRGAN models of UpscalerJS
 # (TensorFlow.js layers models), looked up at run time in $IESRGS_NPM_DIR or third_party/npm.
-# Thick (115 MB) is the one `--sr-model auto` uses; slim (4 MB) is checked against TensorFlow.js.
-for variant in thick slim; do
-  if [ ! -f "third_party/npm/node_modules/@upscalerjs/esrgan-$variant/models/x4/model.json" ]; then
-    npm install --prefix third_party/npm --no-save --omit=peer --no-audit --no-fund \
-      @upscalerjs/esrgan-thick@1.0.0 @upscalerjs/esrgan-slim@1.0.0
-    break
-  fi
-done
+# Thick (115 MB) is the one `--sr-model auto` uses; slim (4 MB) is checked against TensorFlow.js
+# (kSetupEsrganVariants in src/priors/sr/esrgan.hpp). One command for both: npm would remove the
+# other unsaved package.
+packages=third_party/npm/node_modules/@upscalerjs
+if [ ! -f "$packages/esrgan-thick/models/x4/model.json" ] ||
+   [ ! -f "$packages/esrgan-slim/models/x4/model.json" ]; then
+  npm install --prefix third_party/npm --no-save --omit=peer --no-audit --no-fund \
+    @upscalerjs/esrgan-thick@1.0.0 @upscalerjs/esrgan-slim@1.0.0
+fi
 
 build_dir=build
 options=(-DCMAKE_BUILD_TYPE=Release)

@@ -64,14 +64,16 @@ fs::path npm_dir() {
   return dir && *dir ? fs::path(dir) : fs::path(IESRGS_DEFAULT_NPM_DIR);
 }
 
-// Setup installs the thick package (the default prior) and the slim one (whose outputs the tests
-// check against TensorFlow.js'), so medium needs the npm command spelled out; the loader was
+// The npm command spelled out, since setup installs only kSetupEsrganVariants; the loader was
 // checked against the 1.0.0 packages.
-std::string install_hint(const std::string& name, bool default_location) {
+std::string install_hint(const std::string& variant, bool default_location) {
+  const std::string name = "esrgan-" + variant;
   if (!default_location) return fmt::format("the folder is not an @upscalerjs/{} package", name);
+  const bool from_setup =
+      std::find(std::begin(kSetupEsrganVariants), std::end(kSetupEsrganVariants), variant) !=
+      std::end(kSetupEsrganVariants);
   return fmt::format("npm install --prefix {} @upscalerjs/{}@1.0.0 installs it{}",
-                     npm_dir().string(), name,
-                     name == "esrgan-medium" ? "" : ", and so does scripts/setup.sh");
+                     npm_dir().string(), name, from_setup ? ", and so does scripts/setup.sh" : "");
 }
 
 }  // namespace
@@ -94,7 +96,7 @@ std::unique_ptr<SrNet> make_esrgan(const std::string& variant, int scale,
   const fs::path model_json = esrgan_model_dir(variant, scale, package_dir) / "model.json";
   if (!fs::exists(model_json))
     fail_file(model_json, fmt::format("{} is not installed ({})", name,
-                                      install_hint(name, package_dir.empty())));
+                                      install_hint(variant, package_dir.empty())));
   keras::LayersModel model = keras::LayersModel::load(model_json);
   if (model.input_channels() != 3) fail_file(model_json, "the model does not take RGB input");
   return std::make_unique<Esrgan>(name, scale, found.pixel_range, std::move(model));

@@ -10,6 +10,10 @@
 
 namespace iesrgs::priors::sr {
 
+// The variants scripts/setup.sh installs, best first ("--sr-model auto" takes the first present):
+// thick is the default prior, slim's outputs are checked against TensorFlow.js'.
+inline constexpr const char* kSetupEsrganVariants[] = {"thick", "slim"};
+
 // @upscalerjs/esrgan-<variant> ("slim", "medium" or "thick") at `scale` (2, 3, 4 or 8), read from
 // `package_dir`, the package's folder (holding models/x<scale>/model.json); an empty path selects
 // default_esrgan_package_dir(variant). Throws Error naming the model or file and the problem.
@@ -22,8 +26,8 @@ std::filesystem::path esrgan_model_dir(const std::string& variant, int scale,
                                        const std::filesystem::path& package_dir);
 
 // <npm dir>/node_modules/@upscalerjs/esrgan-<variant>, where <npm dir> is $IESRGS_NPM_DIR or, when
-// that is unset, third_party/npm in the source tree (scripts/setup.sh installs esrgan-thick and
-// esrgan-slim there).
+// that is unset, third_party/npm in the source tree (where scripts/setup.sh installs
+// kSetupEsrganVariants).
 std::filesystem::path default_esrgan_package_dir(const std::string& variant);
 
 }  // namespace iesrgs::priors::sr

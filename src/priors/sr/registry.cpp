@@ -149,7 +149,7 @@ std::unique_ptr<SrNet> make_sr_net(const std::string& model, const fs::path& wei
 
 std::string auto_sr_model(int scale) {
   if (fs::exists(default_sr_weights("safmn", scale))) return "safmn";
-  for (const char* variant : {"thick", "slim"})
+  for (const char* variant : kSetupEsrganVariants)
     if (fs::exists(esrgan_model_dir(variant, scale, {}) / "model.json"))
       return std::string("esrgan-") + variant;
   return "bicubic";

@@ -6,7 +6,7 @@
 #include <map>
 #include <optional>
 
-#include "io/atomic_file.hpp"
+#include "priors/sr/esrgan.hpp"
 #include "priors/sr/sr_test_support.hpp"
 #include "support/expect_error.hpp"
 #include "support/scoped_env.hpp"
@@ -19,6 +19,7 @@ using iesrgs::testing::contains;
 using iesrgs::testing::error_message;
 using iesrgs::testing::ScopedEnv;
 using iesrgs::testing::TempDir;
+using iesrgs::testing::write_text;
 
 TEST(SrRegistry, KnowsTheBuiltInModels) {
   const std::vector<std::string>& names = sr_model_names();
@@ -51,17 +52,13 @@ TEST(SrRegistry, AutoPicksSafmnThenTheBestInstalledEsrganThenBicubic) {
   TempDir weights_dir, npm_dir;
   ScopedEnv weights("IESRGS_WEIGHTS_DIR", weights_dir.path().string());
   ScopedEnv npm("IESRGS_NPM_DIR", npm_dir.path().string());
-  const auto install = [](const std::filesystem::path& file) {
-    std::filesystem::create_directories(file.parent_path());
-    write_file_atomically(file, "{}");
-  };
   EXPECT_EQ(auto_sr_model(4), "bicubic");
-  install(npm_dir / "node_modules/@upscalerjs/esrgan-slim/models/x4/model.json");
+  write_text(default_esrgan_package_dir("slim") / "models/x4/model.json", "{}");
   EXPECT_EQ(auto_sr_model(4), "esrgan-slim");
-  install(npm_dir / "node_modules/@upscalerjs/esrgan-thick/models/x4/model.json");
+  write_text(default_esrgan_package_dir("thick") / "models/x4/model.json", "{}");
   EXPECT_EQ(auto_sr_model(4), "esrgan-thick");
   EXPECT_EQ(auto_sr_model(2), "bicubic");
-  install(weights_dir / "sr/SAFMN_x4.pth");
+  write_text(default_sr_weights("safmn", 4), "");
   EXPECT_EQ(auto_sr_model(4), "safmn");
 }
 
