@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "gs/adam.hpp"
 
 namespace iesrgs::gs {
 
@@ -13,22 +14,11 @@ namespace {
 const char* const kParamNames[kParamCount] = {"means",          "sh_dc",      "sh_rest",
                                               "opacity_logits", "log_scales", "quats"};
 
-// torch::optim::Adam's update order and float arithmetic, so both agree to rounding.
 void adam_update(float* param, const float* grad, float* first, float* second, int64_t count,
                  float step_size, float bias2_sqrt) {
-  const float b1 = float(GaussianOptimizer::kBeta1), b2 = float(GaussianOptimizer::kBeta2);
-  const float eps = float(GaussianOptimizer::kEpsilon);
-  const float one_minus_b1 = float(1 - GaussianOptimizer::kBeta1);
-  const float one_minus_b2 = float(1 - GaussianOptimizer::kBeta2);
 #pragma omp parallel for simd schedule(static)
-  for (int64_t i = 0; i < count; ++i) {
-    const float g = grad[i];
-    const float m = first[i] * b1 + g * one_minus_b1;
-    const float v = second[i] * b2 + g * g * one_minus_b2;
-    first[i] = m;
-    second[i] = v;
-    param[i] -= step_size * (m / (std::sqrt(v) / bias2_sqrt + eps));
-  }
+  for (int64_t i = 0; i < count; ++i)
+    adam_update_value(param[i], grad[i], first[i], second[i], step_size, bias2_sqrt);
 }
 
 }  // namespace
@@ -71,8 +61,8 @@ double GaussianOptimizer::learning_rate(Param p) const {
 
 void GaussianOptimizer::step(GaussianModel& model) {
   const int64_t step = steps_ + 1;
-  const double bias1 = 1 - std::pow(kBeta1, double(step));
-  const double bias2 = 1 - std::pow(kBeta2, double(step));
+  const double bias1 = 1 - std::pow(kAdamBeta1, double(step));
+  const double bias2 = 1 - std::pow(kAdamBeta2, double(step));
   for (int p = 0; p < kParamCount; ++p) {
     torch::Tensor& param = model.param(Param(p));
     const torch::Tensor& grad = param.grad();

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 
+#include "gs/adam.hpp"
 #include "gs/model.hpp"
 
 namespace iesrgs::gs {
@@ -55,8 +56,6 @@ class GaussianOptimizer {
   // parameter's in `model`.
   void save_state(torch::serialize::OutputArchive& archive) const;
   void load_state(torch::serialize::InputArchive& archive, const GaussianModel& model);
-
-  static constexpr double kBeta1 = 0.9, kBeta2 = 0.999, kEpsilon = 1e-15;
 
  private:
   LearningRates rates_;

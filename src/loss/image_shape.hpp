@@ -4,14 +4,15 @@
 #include <cstddef>
 
 #include "core/error.hpp"
+#include "core/hd.hpp"
 
 namespace iesrgs::loss {
 
 struct ImageShape {
   int width = 0, height = 0, channels = 0;
 
-  size_t pixels() const { return size_t(width) * size_t(height); }
-  size_t values() const { return pixels() * size_t(channels); }
+  IESRGS_HD size_t pixels() const { return size_t(width) * size_t(height); }
+  IESRGS_HD size_t values() const { return pixels() * size_t(channels); }
 };
 
 // Throws Error("<what>: ...") for an empty or negative size.

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "loss/ssim_point.hpp"
+
 namespace iesrgs::loss {
 namespace {
 
@@ -14,19 +16,14 @@ constexpr int kRadius = kSsimWindow / 2;
 constexpr int kMomentPlanes = 4;   // MomentRows
 constexpr int kPartialPlanes = 3;  // d/d mean, d/d mean square, d/d mean product
 
-// The normalized 1-D Gaussian; the 2-D window is its outer product.
+// The window's taps in the kernels' scalar type.
 template <typename T>
 struct Window {
   T tap[kSsimWindow];
 
   Window() {
-    double weight[kSsimWindow], sum = 0;
-    for (int k = 0; k < kSsimWindow; ++k) {
-      const double d = k - kRadius;
-      weight[k] = std::exp(-d * d / (2 * kSsimSigma * kSsimSigma));
-      sum += weight[k];
-    }
-    for (int k = 0; k < kSsimWindow; ++k) tap[k] = T(weight[k] / sum);
+    const auto weight = ssim_window();
+    for (int k = 0; k < kSsimWindow; ++k) tap[k] = T(weight[k]);
   }
 };
 
@@ -165,26 +162,6 @@ void combine_moments(const T* tap, const T* const* xs, const T* const* ys, const
     out.spread[x] = spread;
     out.cross[x] = cross;
   }
-}
-
-// SSIM of one channel at one pixel and its derivatives with respect to the window mean, mean
-// square and mean product of x (the convolutions of x, x^2 and x*y).
-template <typename T>
-struct SsimPoint {
-  T value, d_mean, d_square, d_cross;
-};
-
-template <typename T>
-SsimPoint<T> ssim_point(T mean_x, T mean_y, T spread, T cross) {
-  const T c1 = T(kSsimC1), c2 = T(kSsimC2);
-  const T a1 = 2 * mean_x * mean_y + c1, a2 = 2 * cross + c2;
-  const T b1 = mean_x * mean_x + mean_y * mean_y + c1, b2 = spread + c2;
-  const T inv_b = 1 / (b1 * b2);
-  const T value = a1 * a2 * inv_b;
-  // The variances are the mean square minus the squared mean, hence the b2 - b1 and a2 - a1
-  // terms of the mean's derivative.
-  return {value, 2 * (mean_y * (a2 - a1) - value * mean_x * (b2 - b1)) * inv_b, -value / b2,
-          2 * a1 * inv_b};
 }
 
 // The forward pass over the pixels of one box: map and partials there, nothing elsewhere.

@@ -1,7 +1,7 @@
 #pragma once
 // Fixed-size vectors and matrices for the raster math, templated on the scalar so that the same
 // kernels run in float (production) and double (gradient checks).
-#include "raster/hd.hpp"
+#include "core/hd.hpp"
 
 namespace iesrgs::raster {
 

@@ -25,24 +25,6 @@ class StageTimer {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
-template <typename T>
-void validate(const GaussianParams<T>& g, const RasterCamera<T>& cam) {
-  if (cam.width <= 0 || cam.height <= 0)
-    fail("rasterizer: image size {}x{} is not positive", cam.width, cam.height);
-  if (!(cam.fx > 0 && cam.fy > 0))
-    fail("rasterizer: focal lengths {} {} are not positive", cam.fx, cam.fy);
-  if (g.count < 0) fail("rasterizer: negative Gaussian count {}", g.count);
-  if (g.sh_degree < 0 || g.sh_degree > gs::kMaxShDegree)
-    fail("rasterizer: SH degree {} is outside 0..{}", g.sh_degree, gs::kMaxShDegree);
-  if (g.count > 0 && !(g.means && g.log_scales && g.quats && g.opacity_logits && g.sh))
-    fail("rasterizer: a Gaussian parameter array is missing");
-}
-
-template <typename T>
-void zero(T* data, size_t count) {
-  if (data) std::fill_n(data, count, T(0));
-}
-
 }  // namespace
 
 template <typename T>
@@ -61,9 +43,22 @@ RasterCamera<T> raster_camera(const Camera& camera) {
 }
 
 template <typename T>
+void validate_inputs(const GaussianParams<T>& g, const RasterCamera<T>& cam) {
+  if (cam.width <= 0 || cam.height <= 0)
+    fail("rasterizer: image size {}x{} is not positive", cam.width, cam.height);
+  if (!(cam.fx > 0 && cam.fy > 0))
+    fail("rasterizer: focal lengths {} {} are not positive", cam.fx, cam.fy);
+  if (g.count < 0) fail("rasterizer: negative Gaussian count {}", g.count);
+  if (g.sh_degree < 0 || g.sh_degree > gs::kMaxShDegree)
+    fail("rasterizer: SH degree {} is outside 0..{}", g.sh_degree, gs::kMaxShDegree);
+  if (g.count > 0 && !(g.means && g.log_scales && g.quats && g.opacity_logits && g.sh))
+    fail("rasterizer: a Gaussian parameter array is missing");
+}
+
+template <typename T>
 void rasterize_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
                        const T background[3], RasterFrame<T>& frame, const RenderTargets<T>& out) {
-  validate(g, cam);
+  validate_inputs(g, cam);
   frame.camera = cam;
   std::copy_n(background, 3, frame.background);
   frame.splats.resize(g.count);
@@ -84,14 +79,8 @@ void rasterize_backward(const GaussianParams<T>& g, RasterFrame<T>& frame,
   if (size_t(g.count) != frame.splats.size())
     fail("rasterizer: backward got {} Gaussians, forward rendered {}", g.count,
          frame.splats.size());
-  const size_t n = size_t(g.count);
-  zero(grads.means, 3 * n);
-  zero(grads.log_scales, 3 * n);
-  zero(grads.quats, 4 * n);
-  zero(grads.opacity_logits, n);
-  zero(grads.sh, 3 * gs::kShCoefficients * n);
-  zero(grads.viewspace, 2 * n);
-  zero(grads.viewspace_abs, 2 * n);
+  for (const GradArray<T>& a : grad_arrays(grads, size_t(g.count)))
+    if (a.data) std::fill_n(a.data, a.size, T(0));
   StageTimer timer;
   cpu::blend_backward(frame, pixel_grads.image, pixel_grads.alpha, pixel_grads.depth);
   frame.timings.blend_backward = timer.lap();
@@ -101,6 +90,8 @@ void rasterize_backward(const GaussianParams<T>& g, RasterFrame<T>& frame,
 
 template RasterCamera<float> raster_camera(const Camera&);
 template RasterCamera<double> raster_camera(const Camera&);
+template void validate_inputs(const GaussianParams<float>&, const RasterCamera<float>&);
+template void validate_inputs(const GaussianParams<double>&, const RasterCamera<double>&);
 template void rasterize_forward(const GaussianParams<float>&, const RasterCamera<float>&,
                                 const float[3], RasterFrame<float>&, const RenderTargets<float>&);
 template void rasterize_forward(const GaussianParams<double>&, const RasterCamera<double>&,

@@ -2,6 +2,9 @@
 // The differentiable Gaussian rasterizer on the CPU: 3DGS tile rasterization with Mip-Splatting's
 // filters. Forward renders color, alpha and depth; backward turns gradients of those images into
 // gradients of every Gaussian parameter. Instantiated for float and double (gradient checks).
+#include <array>
+
+#include "gs/sh.hpp"
 #include "io/camera.hpp"
 #include "raster/frame.hpp"
 
@@ -24,8 +27,32 @@ struct PixelGrads {
   const T* depth = nullptr;
 };
 
+// One array of GaussianGrads and its length; data may be null (not wanted).
+template <typename T>
+struct GradArray {
+  T* data;
+  size_t size;
+};
+
+// Every array of grads for n Gaussians, for the backward passes to clear.
+template <typename T>
+std::array<GradArray<T>, 7> grad_arrays(const GaussianGrads<T>& grads, size_t n) {
+  return {{{grads.means, 3 * n},
+           {grads.log_scales, 3 * n},
+           {grads.quats, 4 * n},
+           {grads.opacity_logits, n},
+           {grads.sh, 3 * gs::kShCoefficients * n},
+           {grads.viewspace, 2 * n},
+           {grads.viewspace_abs, 2 * n}}};
+}
+
 template <typename T>
 RasterCamera<T> raster_camera(const Camera& camera);
+
+// Throws Error on sizes, focal lengths or an SH degree the kernels cannot take, or a missing
+// parameter array.
+template <typename T>
+void validate_inputs(const GaussianParams<T>& g, const RasterCamera<T>& cam);
 
 // Renders g seen by cam over background; frame keeps what the backward pass needs.
 // Throws Error on invalid sizes or SH degree.

@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "raster/hd.hpp"
+#include "core/hd.hpp"
 
 namespace iesrgs::raster {
 
@@ -33,6 +33,23 @@ struct GaussianParams {
   bool antialiased = true;  // Mip-Splatting's 2D filter; false: 3DGS's dilation ("classic")
 };
 
+// GaussianParams viewing the arrays of `storage` (host or device arrays with data() and size(),
+// named as in GaussianBuffers); no 3D filter where filter_std is empty.
+template <typename T, typename Storage>
+GaussianParams<T> params_of(const Storage& storage) {
+  GaussianParams<T> g;
+  g.count = int(storage.opacity_logits.size());
+  g.sh_degree = storage.sh_degree;
+  g.means = storage.means.data();
+  g.log_scales = storage.log_scales.data();
+  g.quats = storage.quats.data();
+  g.opacity_logits = storage.opacity_logits.data();
+  g.sh = storage.sh.data();
+  g.filter_std = storage.filter_std.size() > 0 ? storage.filter_std.data() : nullptr;
+  g.antialiased = storage.antialiased;
+  return g;
+}
+
 // Owning storage behind GaussianParams: the benchmarks' scenes and the kernel tests' scenes.
 template <typename T>
 struct GaussianBuffers {
@@ -41,19 +58,7 @@ struct GaussianBuffers {
   bool antialiased = true;
 
   int count() const { return int(opacity_logits.size()); }
-  GaussianParams<T> params() const {
-    GaussianParams<T> g;
-    g.count = count();
-    g.sh_degree = sh_degree;
-    g.means = means.data();
-    g.log_scales = log_scales.data();
-    g.quats = quats.data();
-    g.opacity_logits = opacity_logits.data();
-    g.sh = sh.data();
-    g.filter_std = filter_std.data();
-    g.antialiased = antialiased;
-    return g;
-  }
+  GaussianParams<T> params() const { return params_of<T>(*this); }
 };
 
 // Gradients with respect to GaussianParams, same shapes, plus the screen-space gradients that

@@ -2,41 +2,21 @@
 // Per-tile sorts are small and independent, so they run in parallel and stay in cache, unlike
 // one global sort by a (tile, depth) key; the order is the same.
 #include <algorithm>
-#include <cstring>
 
 #include "core/error.hpp"
 #include "raster/cpu/kernels.hpp"
+#include "raster/tiles.hpp"
 
 namespace iesrgs::raster::cpu {
 
 namespace {
-
-struct TileRect {
-  int x0, y0, x1, y1;
-};
-
-TileRect tiles_of(const PixelRect& r) {
-  if (r.empty()) return {0, 0, 0, 0};
-  return {r.x0 / kTileSize, r.y0 / kTileSize, (r.x1 - 1) / kTileSize + 1,
-          (r.y1 - 1) / kTileSize + 1};
-}
-
-// Camera z is above the near plane, hence positive: the IEEE bits of a positive float sort like
-// its value. Ties are broken by the slot, i.e. by Gaussian index.
-template <typename T>
-uint32_t depth_bits(T depth) {
-  const float d = static_cast<float>(depth);
-  uint32_t bits;
-  std::memcpy(&bits, &d, sizeof bits);
-  return bits;
-}
 
 // Gaussian-major slot offsets: Gaussian g owns [start[g], start[g + 1]).
 void count_slots(const PixelRect* rects, int count, TileBins& bins) {
   bins.gaussian_start.assign(size_t(count) + 1, 0);
   for (int g = 0; g < count; ++g) {
     const TileRect t = tiles_of(rects[g]);
-    bins.gaussian_start[g + 1] = bins.gaussian_start[g] + uint64_t(t.x1 - t.x0) * (t.y1 - t.y0);
+    bins.gaussian_start[g + 1] = bins.gaussian_start[g] + t.count();
   }
   // Slots are stored as 32-bit indices.
   if (bins.gaussian_start[count] >= (uint64_t(1) << 32))
@@ -69,7 +49,8 @@ void group_by_tile(const Splat<T>* splats, TileBins& bins) {
   bins.keys.resize(entries);
   for (size_t s = 0; s < entries; ++s) {
     const uint32_t g = bins.slot_gaussian[s];
-    bins.keys[cursor[bins.slot_tile[s]]++] = uint64_t(depth_bits(splats[g].depth)) << 32 | s;
+    // Ties in depth are broken by the slot, i.e. by Gaussian index.
+    bins.keys[cursor[bins.slot_tile[s]]++] = uint64_t(depth_bits(float(splats[g].depth))) << 32 | s;
   }
 }
 

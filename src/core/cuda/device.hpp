@@ -1,0 +1,26 @@
+#pragma once
+// Whether, and which, CUDA device this process can use.
+#include <cuda_runtime.h>
+
+#include <string>
+
+#include "core/cuda/check.hpp"
+
+namespace iesrgs::cuda {
+
+// False without a GPU or a driver: the CUDA tests skip, the CUDA benchmark stops.
+inline bool device_available() {
+  int count = 0;
+  return cudaGetDeviceCount(&count) == cudaSuccess && count > 0;
+}
+
+// The current device's name and compute capability, e.g. "NVIDIA H100 80GB HBM3 (sm_90)".
+inline std::string device_description() {
+  int device = 0;
+  check(cudaGetDevice(&device), "cudaGetDevice");
+  cudaDeviceProp prop;
+  check(cudaGetDeviceProperties(&prop, device), "cudaGetDeviceProperties");
+  return fmt::format("{} (sm_{}{})", prop.name, prop.major, prop.minor);
+}
+
+}  // namespace iesrgs::cuda
