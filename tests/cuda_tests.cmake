@@ -4,5 +4,6 @@
 find_package(GTest REQUIRED)
 file(GLOB IESRGS_CUDA_TEST_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/*/cuda/*_test.cpp)
 add_executable(iesrgs_cuda_tests ${IESRGS_CUDA_TEST_SOURCES})
+target_include_directories(iesrgs_cuda_tests PRIVATE ${CMAKE_CURRENT_LIST_DIR})
 target_link_libraries(iesrgs_cuda_tests PRIVATE iesrgs_cuda GTest::gtest GTest::gtest_main)
 add_test(NAME iesrgs_cuda_tests COMMAND iesrgs_cuda_tests)

@@ -67,6 +67,13 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
+// Gradient floats per Gaussian: GaussianGrads' arrays laid end to end.
+constexpr size_t kGradFloats = 3 + 3 + 4 + 1 + 3 * gs::kShCoefficients + 2 + 2;
+
+GaussianGrads<float> packed_grads(float* p, size_t n) {
+  return {p, p + 3 * n, p + 6 * n, p + 10 * n, p + 11 * n, p + 59 * n, p + 61 * n};
+}
+
 // Every buffer of one frame, forward and backward, on the device.
 struct CudaFrame {
   cuda::DeviceGaussians scene;
@@ -80,7 +87,7 @@ struct CudaFrame {
     depth.reserve(pixels);
     dimage.upload(std::vector<float>(3 * pixels, 1e-3f));
     radii.reserve(size_t(cloud.count()));
-    grads.reserve(size_t(cloud.count()) * (3 + 3 + 4 + 1 + 3 * gs::kShCoefficients + 2 + 2));
+    grads.reserve(size_t(cloud.count()) * kGradFloats);
   }
   void forward(const RasterCamera<float>& cam) {
     const float background[3] = {1, 1, 1};
@@ -89,11 +96,8 @@ struct CudaFrame {
         RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
   }
   void backward() {
-    const size_t n = scene.opacity_logits.size();
-    float* p = grads.data();
-    const GaussianGrads<float> g{p,          p + 3 * n,  p + 6 * n, p + 10 * n,
-                                 p + 11 * n, p + 59 * n, p + 61 * n};
-    rasterizer.backward(scene.params(), PixelGrads<float>{dimage.data(), nullptr, nullptr}, g);
+    rasterizer.backward(scene.params(), PixelGrads<float>{dimage.data(), nullptr, nullptr},
+                        packed_grads(grads.data(), scene.opacity_logits.size()));
   }
 };
 
@@ -110,7 +114,7 @@ void bench_cpu(const GaussianCloud& cloud, const RasterCamera<float>& cam, int f
   const size_t pixels = size_t(cam.width) * cam.height, n = size_t(cloud.count());
   std::vector<float> image(3 * pixels), alpha(pixels), depth(pixels), dimage(3 * pixels, 1e-3f);
   std::vector<int32_t> radii(n);
-  std::vector<float> grads(n * 63);
+  std::vector<float> grads(n * kGradFloats);
   RasterFrame<float> frame;
   const float background[3] = {1, 1, 1};
   const auto forward = [&] {
@@ -118,12 +122,10 @@ void bench_cpu(const GaussianCloud& cloud, const RasterCamera<float>& cam, int f
                       RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
   };
   const double fwd = time_frames(frames, forward);
-  float* p = grads.data();
   const double both = time_frames(frames, [&] {
     forward();
     rasterize_backward(cloud.params(), frame, PixelGrads<float>{dimage.data(), nullptr, nullptr},
-                       GaussianGrads<float>{p, p + 3 * n, p + 6 * n, p + 10 * n, p + 11 * n,
-                                            p + 59 * n, p + 61 * n});
+                       packed_grads(grads.data(), n));
   });
   fmt::print("| {:>9} | CPU, {:>2} threads | {:>9.3f} | {:>9.3f} | {:>7.1f} | | | |\n", n,
              omp_get_max_threads(), fwd, both, 1000.0 / fwd);

@@ -7,6 +7,7 @@
 #include "gs/sh.hpp"
 #include "io/camera.hpp"
 #include "raster/rasterizer.hpp"
+#include "support/compare.hpp"
 
 namespace iesrgs::raster::testkit {
 
@@ -143,14 +144,6 @@ KernelRender<T> kernel_render(const Scene<T>& s, const Camera& cam, const T back
   return r;
 }
 
-// Infinite for vectors of different sizes, so that a comparison against it fails.
-template <typename A, typename B>
-double max_abs_diff(const std::vector<A>& a, const std::vector<B>& b) {
-  if (a.size() != b.size()) return INFINITY;
-  double worst = 0;
-  for (size_t i = 0; i < a.size(); ++i)
-    worst = std::max(worst, std::abs(double(a[i]) - double(b[i])));
-  return worst;
-}
+using iesrgs::testing::max_abs_diff;
 
 }  // namespace iesrgs::raster::testkit

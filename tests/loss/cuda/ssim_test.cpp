@@ -11,6 +11,7 @@
 
 #include "core/cuda/device.hpp"
 #include "loss/ssim.hpp"
+#include "support/compare.hpp"
 
 namespace iesrgs::loss::cuda {
 namespace {
@@ -23,21 +24,6 @@ std::vector<float> random_values(size_t n, uint32_t seed, float lo, float hi) {
   std::vector<float> v(n);
   for (float& x : v) x = u(rng);
   return v;
-}
-
-float max_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
-  float m = 0;
-  for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
-  return m;
-}
-
-double relative_error(const std::vector<float>& a, const std::vector<float>& b) {
-  double diff = 0, norm = 0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    diff += double(a[i] - b[i]) * (a[i] - b[i]);
-    norm += double(b[i]) * b[i];
-  }
-  return std::sqrt(diff / norm);
 }
 
 // x is y plus noise, with a flat region where the window statistics nearly cancel.
@@ -66,9 +52,9 @@ void expect_same(const ImageShape& shape, bool sparse_weight) {
   kernels.backward(dx.data(), dy.data(), shape, dpartials.data(), dweight.data(), dgrad.data());
 
   EXPECT_NEAR(gpu_mean, mean, 1e-6);
-  EXPECT_LE(max_abs_diff(dmap.download(), map), 1e-5f);
-  EXPECT_LE(relative_error(dpartials.download(), partials), 1e-5);
-  EXPECT_LE(relative_error(dgrad.download(), grad), 1e-5);
+  EXPECT_LE(testing::max_abs_diff(dmap.download(), map), 1e-5f);
+  EXPECT_LE(testing::relative_l2_error(dpartials.download(), partials), 1e-5);
+  EXPECT_LE(testing::relative_l2_error(dgrad.download(), grad), 1e-5);
   // Without map and partials, the mean alone.
   EXPECT_NEAR(kernels.forward(dx.data(), dy.data(), shape, nullptr, nullptr), mean, 1e-6);
 }

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "gs/sh.hpp"
 #include "raster/synthetic_scene.hpp"
+#include "support/compare.hpp"
 
 namespace iesrgs::raster::cuda {
 namespace {
@@ -139,17 +140,6 @@ void expect_close_pixels(const std::vector<float>& gpu, const std::vector<float>
               double(tolerance), double(worst));
 }
 
-// |a - b| / |b| in the 2-norm over the whole array: per-element ratios are meaningless where a
-// gradient is a sum of terms that nearly cancel.
-double relative_error(const std::vector<float>& a, const std::vector<float>& b) {
-  double diff = 0, norm = 0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    diff += double(a[i] - b[i]) * (a[i] - b[i]);
-    norm += double(b[i]) * b[i];
-  }
-  return norm > 0 ? std::sqrt(diff / norm) : std::sqrt(diff);
-}
-
 void expect_same(const GaussianCloud& cloud, const RasterCamera<float>& cam, const float bg[3],
                  Rasterizer& rasterizer) {
   const PixelGradsHost dpix = random_pixel_grads(cam.width, cam.height, 7);
@@ -175,7 +165,7 @@ void expect_same(const GaussianCloud& cloud, const RasterCamera<float>& cam, con
                 {"viewspace", dgpu.viewspace, dcpu.viewspace},
                 {"viewspace_abs", dgpu.viewspace_abs, dcpu.viewspace_abs}};
   for (const auto& arr : arrays) {
-    const double error = relative_error(arr.a, arr.b);
+    const double error = testing::relative_l2_error(arr.a, arr.b);
     EXPECT_LE(error, 1e-3) << arr.name;
     std::printf("d%s: relative error %.3g\n", arr.name, error);
   }
