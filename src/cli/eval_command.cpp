@@ -10,6 +10,7 @@
 #include "core/paths.hpp"
 #include "eval/lpips.hpp"
 #include "eval/metrics.hpp"
+#include "io/scene.hpp"
 #include "io/view_images.hpp"
 #include "pipeline/evaluate.hpp"
 
@@ -72,13 +73,6 @@ class GroundTruth {
   }
 
  private:
-  static bool is_scene(const std::filesystem::path& path) {
-    return std::filesystem::is_regular_file(path) ||
-           std::filesystem::exists(path / "transforms_train.json") ||
-           std::filesystem::exists(path / "transforms.json") ||
-           std::filesystem::exists(path / "sparse");
-  }
-
   std::filesystem::path root_;
   std::array<float, 3> background_{};
   std::optional<Scene> scene_;

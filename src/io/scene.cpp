@@ -36,16 +36,38 @@ SceneNormalization Scene::normalization() const {
 
 namespace {
 
-Scene read_any_format(const fs::path& root, const SceneOptions& options) {
+enum class SceneFormat { None, Blender, Nerfstudio, NerfstudioFile, Colmap };
+
+SceneFormat detect_format(const fs::path& root) {
   std::error_code ec;
   if (fs::is_regular_file(root, ec) && root.extension() == ".json")
-    return read_nerfstudio_scene(root, options);
+    return SceneFormat::NerfstudioFile;
+  if (fs::exists(root / "transforms_train.json", ec) ||
+      fs::exists(root / "transforms_test.json", ec))
+    return SceneFormat::Blender;
+  if (fs::exists(root / "transforms.json", ec)) return SceneFormat::Nerfstudio;
+  if (fs::is_directory(root / "sparse", ec)) return SceneFormat::Colmap;
+  return SceneFormat::None;
+}
+
+Scene read_any_format(const fs::path& root, const SceneOptions& options) {
+  switch (detect_format(root)) {
+    case SceneFormat::NerfstudioFile:
+      return read_nerfstudio_scene(root, options);
+    case SceneFormat::Blender:
+      return read_blender_scene(root, options);
+    case SceneFormat::Nerfstudio:
+      return read_nerfstudio_scene(root / "transforms.json", options);
+    case SceneFormat::Colmap:
+      return read_colmap_scene(root, options);
+    case SceneFormat::None:
+      break;
+  }
+  std::error_code ec;
   if (!fs::is_directory(root, ec)) fail_file(root, "scene directory not found");
-  if (fs::exists(root / "transforms_train.json", ec)) return read_blender_scene(root, options);
-  if (fs::exists(root / "transforms.json", ec))
-    return read_nerfstudio_scene(root / "transforms.json", options);
-  if (fs::is_directory(root / "sparse", ec)) return read_colmap_scene(root, options);
-  fail_file(root, "no scene found (looked for transforms_train.json, transforms.json, sparse/0/)");
+  fail_file(root,
+            "no scene found (looked for transforms_train.json, transforms_test.json, "
+            "transforms.json, sparse/0/)");
 }
 
 void require_unique_names(const Scene& scene) {
@@ -62,11 +84,17 @@ void require_unique_names(const Scene& scene) {
 
 }  // namespace
 
+bool is_scene(const fs::path& path) {
+  return detect_format(path) != SceneFormat::None;
+}
+
 void require_training_views(const Scene& scene) {
   if (scene.split(Split::Train).empty())
-    fail_file(scene.root, fmt::format("no training views: all {} images are test views (COLMAP "
-                                      "scenes hold out every --test-every-th image)",
-                                      scene.cameras.size()));
+    fail_file(scene.root, fmt::format("no training views: all {} images are test views ({})",
+                                      scene.cameras.size(),
+                                      scene.format == "blender"
+                                          ? "NeRF-Synthetic scenes train on transforms_train.json"
+                                          : "this format holds out every --test-every-th image"));
 }
 
 Scene load_scene(const fs::path& given_root, const SceneOptions& options) {

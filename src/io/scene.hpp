@@ -47,6 +47,9 @@ struct SceneOptions {
 // when two cameras of a split share a name, since their outputs would overwrite each other.
 Scene load_scene(const std::filesystem::path& root, const SceneOptions& options = {});
 
+// Whether load_scene would recognise a format at `path` (a plain folder of images is not a scene).
+bool is_scene(const std::filesystem::path& path);
+
 // Throws Error naming the scene when it has no training view (every image held out for testing).
 void require_training_views(const Scene& scene);
 

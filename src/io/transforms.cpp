@@ -319,16 +319,19 @@ Scene read_blender_scene(const fs::path& root, const SceneOptions&) {
   Scene scene;
   scene.format = "blender";
   scene.synthetic = true;
+  bool found_any = false;
   for (const auto& [name, split] : {std::pair{"transforms_train.json", Split::Train},
                                     std::pair{"transforms_test.json", Split::Test}}) {
     const fs::path json_path = root / name;
     std::error_code ec;
-    if (split == Split::Test && !fs::exists(json_path, ec)) continue;
+    if (!fs::exists(json_path, ec)) continue;
+    found_any = true;
     const std::vector<Camera> cameras =
         parse_blender_transforms(read_file(json_path), json_path, split, read_image_header);
     require_images_exist(cameras, json_path);
     scene.cameras.insert(scene.cameras.end(), cameras.begin(), cameras.end());
   }
+  if (!found_any) fail_file(root / "transforms_train.json", "not found (nor transforms_test.json)");
   return scene;
 }
 

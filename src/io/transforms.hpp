@@ -10,8 +10,9 @@
 
 namespace iesrgs {
 
-// `root` holds transforms_train.json and, optionally, transforms_test.json with camera_angle_x
-// and RGBA images; transforms_val.json is ignored, as 3DGS does. The image size is read from the
+// `root` holds transforms_train.json, transforms_test.json or both (a test-only folder can be
+// rendered and scored), with camera_angle_x and RGBA images; transforms_val.json is ignored, as
+// 3DGS does. The image size is read from the
 // header of each file's first image.
 Scene read_blender_scene(const std::filesystem::path& root, const SceneOptions& options);
 

@@ -110,11 +110,23 @@ TEST(BlenderScene, WithoutTestFileHasNoTestCameras) {
   EXPECT_DOUBLE_EQ(k.cy, 5);
 }
 
-TEST(BlenderScene, MissingTrainFileIsAnError) {
+TEST(BlenderScene, TestFileAloneHasOnlyTestCameras) {
   TempDir dir;
+  write_png_file(dir / "test" / "r_0.png", 20, 10);
+  const json document = {{"camera_angle_x", 0.7}, {"frames", {frame("./test/r_0")}}};
+  write_text(dir / "transforms_test.json", document.dump());
+  const Scene scene = read_blender_scene(dir.path(), {});
+  ASSERT_EQ(scene.cameras.size(), 1u);
+  EXPECT_EQ(scene.cameras[0].split, Split::Test);
+  EXPECT_TRUE(is_scene(dir.path()));
+}
+
+TEST(BlenderScene, MissingBothFilesIsAnError) {
+  TempDir dir;
+  EXPECT_FALSE(is_scene(dir.path()));
   const std::string message = error_message([&] { read_blender_scene(dir.path(), {}); });
   EXPECT_NE(message.find("transforms_train.json"), std::string::npos) << message;
-  EXPECT_NE(message.find("not found"), std::string::npos) << message;
+  EXPECT_NE(message.find("not found (nor transforms_test.json)"), std::string::npos) << message;
 }
 
 TEST(BlenderScene, MissingImageIsAnError) {
