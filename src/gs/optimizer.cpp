@@ -44,7 +44,7 @@ GaussianOptimizer::GaussianOptimizer(const GaussianModel& model, const LearningR
 double GaussianOptimizer::learning_rate(Param p) const {
   switch (p) {
     case Param::Means:
-      return position_lr_(steps_);
+      return position_lr_(steps_ + 1);  // 3DGS counts iterations from 1
     case Param::ShDc:
       return rates_.sh_dc;
     case Param::ShRest:

@@ -34,7 +34,8 @@ TEST(GaussianOptimizer, ExponentialScheduleFollows3dgsFormula) {
 TEST(GaussianOptimizer, GroupRatesAre3dgsDefaultsWithPositionTimesExtent) {
   const GaussianModel m = random_model(2);
   const GaussianOptimizer opt(m, LearningRates{}, 4.0);
-  EXPECT_NEAR(opt.learning_rate(Param::Means), 6.4e-4, 1e-15);
+  // The first step is 3DGS's iteration 1.
+  EXPECT_NEAR(opt.learning_rate(Param::Means), 6.4e-4 * std::pow(0.01, 1.0 / 30000), 1e-15);
   EXPECT_EQ(opt.learning_rate(Param::ShDc), 2.5e-3);
   EXPECT_EQ(opt.learning_rate(Param::ShRest), 2.5e-3 / 20);
   EXPECT_EQ(opt.learning_rate(Param::OpacityLogits), 0.05);
