@@ -4,9 +4,9 @@
 #include <torch/torch.h>
 
 #include <cstdio>
-#include <exception>
 
 #include "cli/commands.hpp"
+#include "core/torch_error.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"iesrgs: super-resolution 3D Gaussian Splatting (IE-SRGS) on CPUs and GPUs"};
@@ -38,10 +38,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
-  } catch (const std::bad_alloc&) {
-    return report("out of memory");
-  } catch (const std::exception& e) {
-    return report(e.what());
+  } catch (...) {
+    return report(iesrgs::current_exception_message().c_str());
   }
   return 0;
 }

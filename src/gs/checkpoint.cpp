@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/torch_error.hpp"
 #include "gs/sh.hpp"
 #include "io/atomic_file.hpp"
 
@@ -84,8 +85,7 @@ void load_training_state(const std::filesystem::path& path, GaussianModel& model
     optimizer = std::move(loaded_optimizer);
     stats = std::move(loaded_stats);
   } catch (const c10::Error& e) {
-    const std::string why = e.what_without_backtrace();
-    fail_file(path, "not a readable training checkpoint (" + why.substr(0, why.find('\n')) + ")");
+    fail_file(path, "not a readable training checkpoint (" + torch_error_line(e) + ")");
   } catch (const Error& e) {
     fail_file(path, e.what());
   }

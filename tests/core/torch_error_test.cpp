@@ -1,0 +1,49 @@
+#include "core/torch_error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <new>
+
+#include "core/error.hpp"
+
+namespace iesrgs {
+namespace {
+
+template <typename Throw>
+std::string message_of(Throw throw_it) {
+  try {
+    throw_it();
+  } catch (...) {
+    return current_exception_message();
+  }
+  return "nothing thrown";
+}
+
+c10::Error torch_error(const std::string& message) {
+  return c10::Error(message, "frame #0: somewhere\nframe #1: elsewhere");
+}
+
+TEST(TorchError, FirstLineWithoutTheBacktrace) {
+  const c10::Error error = torch_error("shape mismatch [2, 3]\nsecond line");
+  EXPECT_NE(std::string(error.what()).find("frame #0"), std::string::npos);
+  EXPECT_EQ(torch_error_line(error), "shape mismatch [2, 3]");
+  EXPECT_EQ(message_of([&] { throw error; }), "shape mismatch [2, 3]");
+}
+
+TEST(TorchError, FailedLibTorchAllocationIsOutOfMemoryWithItsSize) {
+  // As LibTorch's CPU allocator words it.
+  const std::string words =
+      "[enforce fail at alloc_cpu.cpp:75] err == 0. DefaultCPUAllocator: can't allocate memory: "
+      "you tried to allocate 196608000000 bytes. Error code 12 (Cannot allocate memory)";
+  EXPECT_EQ(message_of([&] { throw torch_error(words); }),
+            "out of memory (LibTorch asked for 183.1 GiB)");
+}
+
+TEST(TorchError, OtherExceptionsKeepTheirMessage) {
+  EXPECT_EQ(message_of([] { throw std::bad_alloc(); }), "out of memory");
+  EXPECT_EQ(message_of([] { fail("scene.json: no frames"); }), "scene.json: no frames");
+  EXPECT_EQ(message_of([] { throw 42; }), "unknown error");
+}
+
+}  // namespace
+}  // namespace iesrgs
