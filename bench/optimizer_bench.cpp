@@ -22,8 +22,15 @@ void fill_gradients(GaussianModel& model) {
     model.param(Param(p)).mutable_grad() = torch::randn_like(model.param(Param(p))) * 1e-3;
 }
 
-// Arg: Gaussians.
+// Through LibTorch, whose first operation on a thread would otherwise set OpenMP's thread count
+// back to its own default (one thread with Debian's build).
+void use_threads(int64_t threads) {
+  torch::set_num_threads(int(threads));
+}
+
+// Args: Gaussians, OpenMP threads.
 void BM_AdamStep(benchmark::State& state) {
+  use_threads(state.range(1));
   GaussianModel model = random_model(state.range(0));
   GaussianOptimizer optimizer(model, LearningRates{}, 4.0);
   fill_gradients(model);
@@ -31,8 +38,9 @@ void BM_AdamStep(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 
-// Args: Gaussians, views per iteration.
+// Args: Gaussians, views per iteration, OpenMP threads.
 void BM_DensifyStatistics(benchmark::State& state) {
+  use_threads(state.range(2));
   const int64_t n = state.range(0);
   DensifyStats stats = DensifyStats::zeros(n);
   std::vector<ViewStatistics> views;
@@ -42,10 +50,14 @@ void BM_DensifyStatistics(benchmark::State& state) {
   for (auto _ : state) stats.accumulate(views);
 }
 
-BENCHMARK(BM_AdamStep)->Arg(100000)->Arg(500000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_AdamStep)
+    ->ArgNames({"gaussians", "threads"})
+    ->ArgsProduct({{100000, 500000}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_DensifyStatistics)
-    ->Args({100000, 1})
-    ->Args({100000, 3})
+    ->ArgNames({"gaussians", "views", "threads"})
+    ->ArgsProduct({{100000}, {1, 3}, {1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

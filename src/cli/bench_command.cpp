@@ -1,16 +1,22 @@
-// iesrgs bench raster: times the CPU rasterizer on a synthetic scene (forward, forward+backward,
-// and the cost of each stage).
+// iesrgs bench: times the CPU hot paths on synthetic inputs. `raster`: the rasterizer forward,
+// forward+backward and each stage; `ssim`: the SSIM loss kernel with its backward, as a training
+// step runs it; `adam`: the fused optimizer step over every Gaussian parameter.
 #include <fmt/format.h>
 #include <omp.h>
+#include <torch/torch.h>
 
 #include <algorithm>
 #include <chrono>
 #include <ctime>
+#include <functional>
 #include <vector>
 
 #include "cli/commands.hpp"
 #include "core/error.hpp"
+#include "core/math.hpp"
+#include "gs/optimizer.hpp"
 #include "gs/sh.hpp"
+#include "loss/ssim.hpp"
 #include "raster/cpu/dispatch.hpp"
 #include "raster/rasterizer.hpp"
 #include "raster/synthetic_scene.hpp"
@@ -19,25 +25,66 @@ namespace iesrgs::cli {
 
 namespace {
 
-struct RasterBenchArgs {
-  int gaussians = 100000;
-  int width = 800, height = 800;
+struct RunArgs {
   int threads = 0;  // 0: OpenMP's default
   int iterations = 5;
 };
 
-double elapsed_ms(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-      .count();
+struct RasterBenchArgs {
+  int gaussians = 100000;
+  int width = 800, height = 800;
+  RunArgs run;
+};
+
+struct SsimBenchArgs {
+  int width = 800, height = 800;
+  RunArgs run{0, 20};
+};
+
+struct AdamBenchArgs {
+  int gaussians = 500000;
+  RunArgs run{0, 20};
+};
+
+using Clock = std::chrono::steady_clock;
+
+double elapsed_ms(Clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
+}
+
+struct Medians {
+  double wall_ms = 0;
+  double cpu_ms = 0;  // summed over threads
+};
+
+void apply(const RunArgs& run, const char* command) {
+  if (run.iterations <= 0 || run.threads < 0)
+    fail("bench {}: --iterations must be positive and --threads not negative", command);
+  // Through LibTorch, whose first operation on a thread would otherwise set OpenMP's thread
+  // count back to its own.
+  if (run.threads > 0) torch::set_num_threads(run.threads);
+}
+
+// Runs work(i) for i = -1 (a warm-up that sizes every buffer, not timed) up to iterations - 1.
+// Medians, so that one disturbed run (a shared machine) does not skew the result; on a busy
+// machine wall time overstates the cost, CPU time does not.
+Medians time_runs(int iterations, const std::function<void(int)>& work) {
+  std::vector<double> wall, cpu;
+  for (int it = -1; it < iterations; ++it) {
+    const auto start = Clock::now();
+    const std::clock_t cpu_start = std::clock();
+    work(it);
+    if (it < 0) continue;
+    wall.push_back(elapsed_ms(start));
+    cpu.push_back(1000.0 * double(std::clock() - cpu_start) / CLOCKS_PER_SEC);
+  }
+  return {median(wall), median(cpu)};
 }
 
 void run_raster_bench(const RasterBenchArgs& args) {
-  if (args.gaussians < 0 || args.width <= 0 || args.height <= 0 || args.iterations <= 0 ||
-      args.threads < 0)
-    fail(
-        "bench raster: --width, --height and --iterations must be positive, --gaussians and "
-        "--threads not negative");
-  if (args.threads > 0) omp_set_num_threads(args.threads);
+  if (args.gaussians < 0 || args.width <= 0 || args.height <= 0)
+    fail("bench raster: --width and --height must be positive, --gaussians not negative");
+  apply(args.run, "raster");
   using namespace raster;
   const RasterCamera<float> cam = benchmark_camera(args.width, args.height);
   const GaussianCloud cloud = synthetic_scene(args.gaussians, cam, 1);
@@ -51,11 +98,9 @@ void run_raster_bench(const RasterBenchArgs& args) {
       dsh(3 * gs::kShCoefficients * n), dview(2 * n), dview_abs(2 * n);
   const float background[3] = {1, 1, 1};
   RasterFrame<float> frame;
-  std::vector<double> forward, total, cpu, project, bin, blend, backward;
-  // One warm-up pass sizes every buffer.
-  for (int it = -1; it < args.iterations; ++it) {
-    const auto start = std::chrono::steady_clock::now();
-    const std::clock_t cpu_start = std::clock();
+  std::vector<double> forward, project, bin, blend, backward;
+  const Medians total = time_runs(args.run.iterations, [&](int it) {
+    const auto start = Clock::now();
     rasterize_forward(g, cam, background, frame,
                       RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
     const double forward_ms = elapsed_ms(start);
@@ -63,32 +108,96 @@ void run_raster_bench(const RasterBenchArgs& args) {
         g, frame, PixelGrads<float>{dimage.data(), dalpha.data(), ddepth.data()},
         GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(), dlogits.data(),
                              dsh.data(), dview.data(), dview_abs.data()});
-    if (it < 0) continue;
+    if (it < 0) return;
     forward.push_back(forward_ms);
-    total.push_back(elapsed_ms(start));
-    cpu.push_back(1000.0 * double(std::clock() - cpu_start) / CLOCKS_PER_SEC);
     project.push_back(frame.timings.project);
     bin.push_back(frame.timings.bin);
     blend.push_back(frame.timings.blend);
     backward.push_back(frame.timings.blend_backward + frame.timings.project_backward);
-  }
+  });
   const size_t drawn =
       size_t(std::count_if(radii.begin(), radii.end(), [](int r) { return r > 0; }));
   fmt::print(
       "scene: {} Gaussians ({} drawn), {}x{}, {} tile entries, {} threads, {} iterations "
       "(medians)\n",
       n, drawn, args.width, args.height, frame.bins.entry_count(), omp_get_max_threads(),
-      args.iterations);
+      args.run.iterations);
   fmt::print("blend kernels: {}\n", cpu::describe_isa(cpu::active_isa()));
-  // Medians over iterations, so one disturbed run (a shared machine) does not skew a stage.
   fmt::print("forward: {:.1f} ms\n", median(forward));
-  fmt::print("forward+backward: {:.1f} ms\n", median(total));
+  fmt::print("forward+backward: {:.1f} ms\n", total.wall_ms);
   fmt::print("  projection: {:.1f} ms\n", median(project));
   fmt::print("  binning/sort: {:.1f} ms\n", median(bin));
   fmt::print("  blend: {:.1f} ms\n", median(blend));
   fmt::print("  backward: {:.1f} ms\n", median(backward));
-  // On a busy machine wall time overstates the cost; CPU time (summed over threads) does not.
-  fmt::print("cpu time, forward+backward: {:.1f} ms over all threads\n", median(cpu));
+  fmt::print("cpu time, forward+backward: {:.1f} ms over all threads\n", total.cpu_ms);
+}
+
+// Content does not change the cost; a fixed pattern keeps runs comparable.
+std::vector<float> pattern(size_t count, uint32_t seed) {
+  std::vector<float> values(count);
+  for (size_t i = 0; i < count; ++i)
+    values[i] = float(((i + seed) * 2654435761u) >> 8) / 16777216.f;
+  return values;
+}
+
+void run_ssim_bench(const SsimBenchArgs& args) {
+  if (args.width <= 0 || args.height <= 0)
+    fail("bench ssim: --width and --height must be positive");
+  apply(args.run, "ssim");
+  const loss::ImageShape shape{args.height, args.width, 3};
+  const std::vector<float> x = pattern(shape.values(), 1), y = pattern(shape.values(), 2);
+  std::vector<float> partials(loss::ssim_partials_size(shape)), grad(shape.values());
+  const std::vector<float> weight(shape.pixels(), 1.f / float(shape.pixels()));
+  const Medians forward = time_runs(args.run.iterations, [&](int) {
+    loss::ssim<float>(x.data(), y.data(), shape, nullptr, partials.data());
+  });
+  // What a training step pays: the forward with partials, then the backward of the mean.
+  const Medians total = time_runs(args.run.iterations, [&](int) {
+    loss::ssim<float>(x.data(), y.data(), shape, nullptr, partials.data());
+    loss::ssim_backward<float>(x.data(), y.data(), shape, partials.data(), weight.data(),
+                               grad.data());
+  });
+  fmt::print("image: {}x{} RGB, {} threads, {} iterations (medians)\n", args.width, args.height,
+             omp_get_max_threads(), args.run.iterations);
+  fmt::print("forward (with partials): {:.2f} ms\n", forward.wall_ms);
+  fmt::print("forward+backward: {:.2f} ms ({:.1f} Mpixel/s)\n", total.wall_ms,
+             double(shape.pixels()) / total.wall_ms / 1e3);
+  fmt::print("cpu time, forward+backward: {:.2f} ms over all threads\n", total.cpu_ms);
+}
+
+void run_adam_bench(const AdamBenchArgs& args) {
+  if (args.gaussians <= 0) fail("bench adam: --gaussians must be positive");
+  apply(args.run, "adam");
+  const int64_t n = args.gaussians;
+  torch::manual_seed(1);
+  gs::GaussianModel model;
+  model.set_params({torch::randn({n, 3}), torch::rand({n, 1, 3}), torch::zeros({n, 15, 3}),
+                    torch::zeros({n}), torch::full({n, 3}, -4.0f), torch::randn({n, 4})});
+  int64_t floats = 0;
+  for (int p = 0; p < gs::kParamCount; ++p) {
+    torch::Tensor& param = model.param(gs::Param(p));
+    param.mutable_grad() = torch::randn_like(param) * 1e-3;
+    floats += param.numel();
+  }
+  gs::GaussianOptimizer optimizer(model, gs::LearningRates{}, 4.0);
+  const Medians step = time_runs(args.run.iterations, [&](int) { optimizer.step(model); });
+  // Each float: parameter, gradient and both moments read, parameter and moments written.
+  const double bytes = double(floats) * sizeof(float) * 7;
+  fmt::print("model: {} Gaussians ({} floats), {} threads, {} iterations (medians)\n", n, floats,
+             omp_get_max_threads(), args.run.iterations);
+  fmt::print("Adam step: {:.2f} ms ({:.1f} GB/s of parameters, gradients and moments)\n",
+             step.wall_ms, bytes / step.wall_ms / 1e6);
+  fmt::print("cpu time: {:.2f} ms over all threads\n", step.cpu_ms);
+}
+
+void add_run_options(CLI::App* command, RunArgs& run) {
+  command->add_option("--threads", run.threads, "OpenMP threads (default: all cores)");
+  command->add_option("--iterations", run.iterations, "Timed iterations")->capture_default_str();
+}
+
+void add_image_size(CLI::App* command, int& width, int& height) {
+  command->add_option("--width", width, "Image width")->capture_default_str();
+  command->add_option("--height", height, "Image height")->capture_default_str();
 }
 
 }  // namespace
@@ -96,14 +205,27 @@ void run_raster_bench(const RasterBenchArgs& args) {
 void add_bench_command(CLI::App& app) {
   auto* bench = app.add_subcommand("bench", "Time parts of the system on synthetic inputs");
   bench->require_subcommand(1);
+
   auto* raster = bench->add_subcommand("raster", "Time the CPU rasterizer, forward and backward");
-  auto args = std::make_shared<RasterBenchArgs>();
-  raster->add_option("--gaussians", args->gaussians, "Number of Gaussians")->capture_default_str();
-  raster->add_option("--width", args->width, "Image width")->capture_default_str();
-  raster->add_option("--height", args->height, "Image height")->capture_default_str();
-  raster->add_option("--threads", args->threads, "OpenMP threads (default: all cores)");
-  raster->add_option("--iterations", args->iterations, "Timed iterations")->capture_default_str();
-  raster->callback([args] { run_raster_bench(*args); });
+  auto raster_args = std::make_shared<RasterBenchArgs>();
+  raster->add_option("--gaussians", raster_args->gaussians, "Number of Gaussians")
+      ->capture_default_str();
+  add_image_size(raster, raster_args->width, raster_args->height);
+  add_run_options(raster, raster_args->run);
+  raster->callback([raster_args] { run_raster_bench(*raster_args); });
+
+  auto* ssim = bench->add_subcommand("ssim", "Time the SSIM loss kernel, forward and backward");
+  auto ssim_args = std::make_shared<SsimBenchArgs>();
+  add_image_size(ssim, ssim_args->width, ssim_args->height);
+  add_run_options(ssim, ssim_args->run);
+  ssim->callback([ssim_args] { run_ssim_bench(*ssim_args); });
+
+  auto* adam = bench->add_subcommand("adam", "Time the optimizer step over every parameter");
+  auto adam_args = std::make_shared<AdamBenchArgs>();
+  adam->add_option("--gaussians", adam_args->gaussians, "Number of Gaussians")
+      ->capture_default_str();
+  add_run_options(adam, adam_args->run);
+  adam->callback([adam_args] { run_adam_bench(*adam_args); });
 }
 
 }  // namespace iesrgs::cli

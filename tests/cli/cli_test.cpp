@@ -66,6 +66,29 @@ TEST(Cli, BadDownscaleIsRejected) {
   EXPECT_TRUE(contains(run.output, "--downscale")) << run.output;
 }
 
+TEST(Cli, BenchModesPrintTheirTimings) {
+  const CliRun raster =
+      iesrgs("bench raster --gaussians 200 --width 48 --height 32 --iterations 2");
+  EXPECT_EQ(raster.status, 0) << raster.output;
+  EXPECT_TRUE(contains(raster.output, "scene: 200 Gaussians")) << raster.output;
+  EXPECT_TRUE(contains(raster.output, "forward+backward: ")) << raster.output;
+  const CliRun ssim = iesrgs("bench ssim --width 40 --height 24 --iterations 2 --threads 1");
+  EXPECT_EQ(ssim.status, 0) << ssim.output;
+  EXPECT_TRUE(contains(ssim.output, "image: 40x24 RGB, 1 threads")) << ssim.output;
+  EXPECT_TRUE(contains(ssim.output, "forward+backward: ")) << ssim.output;
+  const CliRun adam = iesrgs("bench adam --gaussians 100 --iterations 2");
+  EXPECT_EQ(adam.status, 0) << adam.output;
+  EXPECT_TRUE(contains(adam.output, "model: 100 Gaussians (5900 floats)")) << adam.output;
+  EXPECT_TRUE(contains(adam.output, "Adam step: ")) << adam.output;
+}
+
+TEST(Cli, BenchRefusesEmptyWork) {
+  EXPECT_EQ(last_line(iesrgs("bench ssim --width 0").output),
+            "error: bench ssim: --width and --height must be positive");
+  EXPECT_EQ(last_line(iesrgs("bench adam --iterations 0").output),
+            "error: bench adam: --iterations must be positive and --threads not negative");
+}
+
 TEST(Cli, UpscaleWritesOnePngPerImageOfAFolder) {
   TempDir dir;
   write_png(dir / "in" / "a.png", Image8(10, 8, 4));
