@@ -16,7 +16,9 @@ std::string allocation_failure(const std::string& line) {
   const size_t at = line.find(marker);
   if (at == std::string::npos) return "out of memory";
   const double bytes = std::strtod(line.c_str() + at + marker.size(), nullptr);
-  return fmt::format("out of memory (LibTorch asked for {:.1f} GiB)", bytes / (1 << 30));
+  return bytes >= (1 << 30)
+             ? fmt::format("out of memory (LibTorch asked for {:.1f} GiB)", bytes / (1 << 30))
+             : fmt::format("out of memory (LibTorch asked for {:.1f} MiB)", bytes / (1 << 20));
 }
 
 }  // namespace

@@ -37,6 +37,11 @@ TEST(TorchError, FailedLibTorchAllocationIsOutOfMemoryWithItsSize) {
       "you tried to allocate 196608000000 bytes. Error code 12 (Cannot allocate memory)";
   EXPECT_EQ(message_of([&] { throw torch_error(words); }),
             "out of memory (LibTorch asked for 183.1 GiB)");
+  const std::string smaller =
+      "DefaultCPUAllocator: can't allocate memory: you tried to allocate "
+      "12582912 bytes. Error code 12 (Cannot allocate memory)";
+  EXPECT_EQ(message_of([&] { throw torch_error(smaller); }),
+            "out of memory (LibTorch asked for 12.0 MiB)");
 }
 
 TEST(TorchError, OtherExceptionsKeepTheirMessage) {
