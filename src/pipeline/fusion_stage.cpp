@@ -8,6 +8,7 @@
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "io/npy.hpp"
+#include "pipeline/stage_record.hpp"
 
 namespace iesrgs::pipeline {
 
@@ -16,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 torch::Tensor read_reference_image(const fs::path& path, const Intrinsics& size) {
-  const Image8 image = read_image8(path);
+  const Image8 image = read_cached_output(path, read_image8);
   if (image.width != size.width || image.height != size.height)
     fail_file(path, fmt::format("is {}x{}, the HR camera is {}x{}", image.width, image.height,
                                 size.width, size.height));
@@ -24,7 +25,7 @@ torch::Tensor read_reference_image(const fs::path& path, const Intrinsics& size)
 }
 
 torch::Tensor read_reference_map(const fs::path& path, const Intrinsics& size) {
-  NpyArray array = read_npy(path);
+  NpyArray array = read_cached_output(path, read_npy);
   if (array.shape != std::vector<size_t>{size_t(size.height), size_t(size.width)})
     fail_file(path, fmt::format("is not a {}x{} (height x width) map", size.height, size.width));
   return torch::from_blob(array.data.data(), {size.height, size.width}, torch::kFloat).clone();

@@ -23,6 +23,16 @@ nlohmann::json sr_params(double model_seconds, int scale) {
   return {{"model_seconds", model_seconds}, {"scale", scale}};
 }
 
+// Whether SR-splatting's renders of every training view are there: one deleted (say, because it
+// was damaged) renders them again.
+bool renders_present(const std::filesystem::path& sr_dir, const Scene& lr_scene) {
+  for (const Camera* camera : lr_scene.split(Split::Train))
+    if (!std::filesystem::exists(sr_dir / "rgb" / (camera->name + ".png")) ||
+        !std::filesystem::exists(sr_dir / "depth" / (camera->name + ".npy")))
+      return false;
+  return true;
+}
+
 }  // namespace
 
 InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train_digest,
@@ -44,7 +54,9 @@ InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train
                          [&] { return train::initial_model(lr_scene, config, {}); }),
       dir / "sr"};
   const nlohmann::json sr = sr_params(stage.training.seconds, scale);
-  if (stage.training.cached && stage_finished(stage.sr_dir, sr)) return stage;
+  if (stage.training.cached && stage_finished(stage.sr_dir, sr) &&
+      renders_present(stage.sr_dir, lr_scene))
+    return stage;
   fmt::print("SR-splatting: rendering {} training views at x{}\n", cameras.size(), scale);
   const auto start = std::chrono::steady_clock::now();
   render_views_to(stage.sr_dir, stage.training.model, cameras, lr_scene.background, scale);
@@ -58,7 +70,8 @@ bool internal_stage_current(const Scene& lr_scene, const std::string& train_dige
                             const train::TrainConfig& config, int scale,
                             const std::filesystem::path& dir) {
   return training_stage_current(dir, internal_params(lr_scene, train_digest), config) &&
-         stage_finished(dir / "sr", sr_params(stage_seconds(dir), scale));
+         stage_finished(dir / "sr", sr_params(stage_seconds(dir), scale)) &&
+         renders_present(dir / "sr", lr_scene);
 }
 
 }  // namespace iesrgs::pipeline

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/error.hpp"
 #include "io/scene.hpp"
 #include "io/view_images.hpp"
 
@@ -13,6 +14,19 @@ namespace iesrgs::pipeline {
 // The record's JSON object; an empty object when the file is missing or damaged, which only costs
 // recomputing the stage.
 nlohmann::json read_stage_record(const std::filesystem::path& path);
+
+// read(path) for an output a cached stage wrote (outputs are written atomically, so damage comes
+// from outside); its Error then also says how to have the file made again.
+template <typename Read>
+auto read_cached_output(const std::filesystem::path& path, Read read) -> decltype(read(path)) {
+  try {
+    return read(path);
+  } catch (const Error& e) {
+    throw Error(
+        std::string(e.what()) +
+        "; it is a cached output of an earlier run: delete it and run again to recompute it");
+  }
+}
 
 // One digest of the cameras of a split of `images`' scene (name, pinhole, distortion, pose), of
 // the content of the image files `images` reads for them and of the background they are

@@ -24,6 +24,11 @@ nlohmann::json stage_identity(const nlohmann::json& params, const train::TrainCo
   return {{"stage", params}, {"training", train::to_json(config)}};
 }
 
+// A finished stage whose model was deleted (say, because it was damaged) trains again.
+bool model_finished(const fs::path& dir, const nlohmann::json& identity) {
+  return stage_finished(dir, identity) && fs::exists(dir / "point_cloud.ply");
+}
+
 }  // namespace
 
 bool stage_finished(const fs::path& dir, const nlohmann::json& params) {
@@ -46,10 +51,10 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
                                const std::function<gs::GaussianModel()>& initial_model) {
   const fs::path dir = setup.output_dir;
   const nlohmann::json identity = stage_identity(params, config);
-  if (stage_finished(dir, identity)) {
+  if (model_finished(dir, identity)) {
     fmt::print("{}: reusing the finished model in {}\n", name, dir.string());
-    return {gs::model_from_splat_cloud(read_ply(dir / "point_cloud.ply")), stage_seconds(dir),
-            true};
+    return {gs::model_from_splat_cloud(read_cached_output(dir / "point_cloud.ply", read_ply)),
+            stage_seconds(dir), true};
   }
   const bool resumable = stage_json(dir).value("params", nlohmann::json()) == identity &&
                          fs::exists(dir / "checkpoint.pt");
@@ -76,7 +81,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
 
 bool training_stage_current(const fs::path& dir, const nlohmann::json& params,
                             const train::TrainConfig& config) {
-  return stage_finished(dir, stage_identity(params, config));
+  return model_finished(dir, stage_identity(params, config));
 }
 
 }  // namespace iesrgs::pipeline

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "io/atomic_file.hpp"
+#include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 #include "synth/dataset_writer.hpp"
 #include "train/session.hpp"
@@ -53,6 +54,26 @@ TEST(TrainingStage, NewSettingsNeverResumeAnOlderSettingsCheckpoint) {
   const StageResult result = run_training_stage("stage", {}, run.config, run.setup, start);
   EXPECT_GT(result.model.size(), 0);
   EXPECT_TRUE(training_stage_current(dir / "stage", {}, run.config));
+}
+
+TEST(TrainingStage, DamagedFinishedModelSaysHowToRecomputeItAndDeletedIsRetrained) {
+  TempDir dir;
+  const StageRun run = tiny_stage(dir / "scene", dir / "stage");
+  const auto start = [&] { return train::initial_model(run.scene, run.config, {}); };
+  run_training_stage("stage", {}, run.config, run.setup, start);
+  const std::filesystem::path ply = dir / "stage" / "point_cloud.ply";
+  write_file_atomically(ply, read_file(ply).substr(0, 300));
+
+  const std::string message = testing::error_message(
+      [&] { run_training_stage("stage", {}, run.config, run.setup, start); });
+  EXPECT_TRUE(testing::contains(message, ply.string())) << message;
+  EXPECT_TRUE(testing::contains(message, "delete it and run again to recompute it")) << message;
+
+  std::filesystem::remove(ply);
+  EXPECT_FALSE(training_stage_current(dir / "stage", {}, run.config));
+  const StageResult again = run_training_stage("stage", {}, run.config, run.setup, start);
+  EXPECT_FALSE(again.cached);
+  EXPECT_TRUE(std::filesystem::exists(ply));
 }
 
 }  // namespace
