@@ -4,13 +4,11 @@
 // decompressor, so an input that starts with 'U' has the rest gzipped first: the fuzzer then
 // mutates the header and attribute streams of versions 2 and 3 directly (fuzz/corpus/spz_fuzzer
 // seeds that mode with the test files' uncompressed contents).
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
 #include <string_view>
-#include <vector>
 
 #include <spdlog/spdlog.h>
 #include <zlib.h>
@@ -20,20 +18,6 @@
 #include "splat_cloud_check.hpp"
 
 namespace {
-
-void abort_unless_finite(const std::vector<float>& values) {
-  for (float v : values)
-    if (!std::isfinite(v)) std::abort();
-}
-
-void abort_unless_unit_quaternions(const std::vector<float>& wxyz) {
-  for (size_t i = 0; i + 4 <= wxyz.size(); i += 4) {
-    const double norm =
-        std::sqrt(double(wxyz[i]) * wxyz[i] + double(wxyz[i + 1]) * wxyz[i + 1] +
-                  double(wxyz[i + 2]) * wxyz[i + 2] + double(wxyz[i + 3]) * wxyz[i + 3]);
-    if (!(std::fabs(norm - 1) < 1e-3)) std::abort();
-  }
-}
 
 std::string gzipped(std::string_view bytes) {
   z_stream stream{};
@@ -66,10 +50,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const iesrgs::SplatCloud cloud =
         iesrgs::parse_spz(compress ? gzipped(input.substr(1)) : input, "fuzz.spz");
     abort_unless_consistent(cloud);
-    for (const auto* values : {&cloud.positions, &cloud.sh_dc, &cloud.sh_rest, &cloud.opacity,
-                               &cloud.log_scales, &cloud.rotations})
-      abort_unless_finite(*values);
-    abort_unless_unit_quaternions(cloud.rotations);
+    abort_unless_finite_with_unit_rotations(cloud);
   } catch (const iesrgs::Error&) {
   }
   return 0;

@@ -43,7 +43,8 @@ void add_export_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "export",
       "Write a trained model as .splat (web viewers), .spz (compressed) or a filter-baked .ply");
-  command->add_option("model", args->model, "Training output folder, a 3DGS .ply or an .spz")
+  command
+      ->add_option("model", args->model, "Training output folder, a 3DGS .ply, an .spz or a .splat")
       ->required();
   command->add_option("output", args->output, "OUT.splat, OUT.spz or OUT.ply")->required();
   command->callback([args] { run_export(*args); });

@@ -92,7 +92,7 @@ void add_info_command(CLI::App& app) {
   auto* command =
       app.add_subcommand("info",
                          "Print a scene's cameras, image size, splits, points and extent, or a "
-                         "trained model's (.ply, .spz) Gaussians");
+                         "trained model's (.ply, .spz, .splat) Gaussians");
   auto args = std::make_shared<SceneArgs>();
   auto load_images = std::make_shared<bool>(false);
   args->add_to(*command);

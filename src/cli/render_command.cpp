@@ -68,7 +68,8 @@ void run_render(const RenderArgs& args) {
 void add_render_command(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* command = app.add_subcommand("render", "Render a trained model from a scene's cameras");
-  command->add_option("model", args->model, "Training output folder, a 3DGS .ply or an .spz")
+  command
+      ->add_option("model", args->model, "Training output folder, a 3DGS .ply, an .spz or a .splat")
       ->required();
   args->scene.add_to(*command);
   command->add_option("-o,--output", args->output, "Output folder (rgb/, depth/, alpha/)")

@@ -111,7 +111,8 @@ void add_train_command(CLI::App& app) {
   command->add_option("--config", args->config_file, "JSON file of training parameters");
   command->add_option("--set", args->assignments,
                       "Override one training parameter, key=value (repeatable; see config.json)");
-  command->add_option("--init-ply", args->init_ply, "Start from this 3DGS .ply or .spz instead");
+  command->add_option("--init-ply", args->init_ply,
+                      "Start from this 3DGS .ply, .spz or .splat instead");
   command->add_flag("--resume", args->resume, "Continue the run in --output from its checkpoint");
   command->callback([args] { run_train(*args); });
 }

@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <string>
 
+#include <fmt/format.h>
+
+#include "core/error.hpp"
 #include "core/math.hpp"
 #include "io/atomic_file.hpp"
 #include "io/viewer_cloud.hpp"
@@ -24,6 +28,30 @@ std::vector<size_t> most_visible_first(const SplatCloud& cloud) {
   std::iota(order.begin(), order.end(), size_t(0));
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key[a] > key[b]; });
   return order;
+}
+
+void read_record(const char* at, size_t i, const std::filesystem::path& name, SplatCloud& cloud) {
+  float floats[6];
+  std::memcpy(floats, at, sizeof floats);
+  for (int k = 0; k < 3; ++k) {
+    if (!std::isfinite(floats[k]))
+      fail_file(name, fmt::format("record {}: position {} is not finite", i, floats[k]));
+    cloud.positions.push_back(floats[k]);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const float scale = floats[3 + k];
+    if (!(scale >= 0) || !std::isfinite(scale))
+      fail_file(name, fmt::format("record {}: scale {} is not a positive number", i, scale));
+    cloud.log_scales.push_back(std::log(std::max(scale, std::numeric_limits<float>::min())));
+  }
+  const auto* bytes = reinterpret_cast<const uint8_t*>(at + sizeof floats);
+  for (int k = 0; k < 3; ++k) cloud.sh_dc.push_back(float((bytes[k] / 255.0 - 0.5) / kShC0));
+  cloud.opacity.push_back(opacity_logit_of_byte(bytes[3]));
+  float q[4];
+  for (int k = 0; k < 4; ++k) q[k] = float((bytes[4 + k] - 128) / 128.0);
+  const double norm = quaternion_norm(q);
+  for (int k = 0; k < 4; ++k)
+    cloud.rotations.push_back(norm > 0 ? float(q[k] / norm) : float(k == 0));
 }
 
 void append_record(std::string& bytes, const SplatCloud& cloud, size_t i) {
@@ -53,6 +81,23 @@ void write_splat(const std::filesystem::path& path, const SplatCloud& cloud) {
   bytes.reserve(baked.size() * kSplatRecordBytes);
   for (size_t i : most_visible_first(baked)) append_record(bytes, baked, i);
   write_file_atomically(path, bytes);
+}
+
+SplatCloud parse_splat(std::string_view bytes, const std::filesystem::path& name) {
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, ".splat floats are little-endian");
+  if (bytes.empty()) fail_file(name, "is empty: no Gaussians");
+  if (bytes.size() % kSplatRecordBytes != 0)
+    fail_file(name, fmt::format("is {} bytes, not a whole number of {}-byte .splat records",
+                                bytes.size(), kSplatRecordBytes));
+  SplatCloud cloud;
+  cloud.antialiased = false;
+  for (size_t i = 0; i < bytes.size() / kSplatRecordBytes; ++i)
+    read_record(bytes.data() + i * kSplatRecordBytes, i, name, cloud);
+  return cloud;
+}
+
+SplatCloud read_splat(const std::filesystem::path& path) {
+  return parse_splat(read_file(path), path);
 }
 
 }  // namespace iesrgs

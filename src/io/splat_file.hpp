@@ -3,6 +3,7 @@
 // it; gsplat and LichtFeld Studio export it too): 32 bytes per Gaussian, no header, colour
 // without view dependence.
 #include <filesystem>
+#include <string_view>
 
 #include "io/ply.hpp"
 
@@ -16,5 +17,15 @@ constexpr size_t kSplatRecordBytes = 32;
 // prod(scale) * opacity), as the viewers stream them. Mip-Splatting's 3D filter is baked in
 // first. Written atomically; throws Error naming the file for a malformed or non-finite cloud.
 void write_splat(const std::filesystem::path& path, const SplatCloud& cloud);
+
+// A .splat file as a cloud of SH degree 0, drawn as the viewers draw it (classic 2D dilation, no
+// 3D filter). Colour and opacity come back to within their 8-bit steps and rotations to within
+// 1/128; a zero scale (a float underflow on export) becomes the smallest normal one and an
+// all-zero rotation the identity. Throws Error naming the file when its size is not a whole
+// number of records or a record holds a non-finite position or a negative or non-finite scale.
+SplatCloud read_splat(const std::filesystem::path& path);
+
+// read_splat on bytes already in memory; `name` is only used in error messages.
+SplatCloud parse_splat(std::string_view bytes, const std::filesystem::path& name);
 
 }  // namespace iesrgs

@@ -300,9 +300,7 @@ SplatCloud decode_streams(const SpzHeader& h, const std::string& streams) {
   const std::string_view positions = in.take(9 * n);
   for (size_t i = 0; i < 3 * n; ++i)
     cloud.positions.push_back(fixed_position(positions, i, h.bits));
-  // Opacity bytes 0 and 255 would be logits of -inf and +inf: half a step inside instead.
-  for (char c : in.take(n))
-    cloud.opacity.push_back(float(logit(std::clamp(double(uint8_t(c)), 0.5, 254.5) / 255)));
+  for (char c : in.take(n)) cloud.opacity.push_back(opacity_logit_of_byte(uint8_t(c)));
   for (char c : in.take(3 * n))
     cloud.sh_dc.push_back(float((uint8_t(c) / 255.0 - 0.5) / kColorScale));
   for (char c : in.take(3 * n)) cloud.log_scales.push_back(float(uint8_t(c) / 16.0 - 10));

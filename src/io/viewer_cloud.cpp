@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/math.hpp"
 
 namespace iesrgs {
 
@@ -41,6 +42,10 @@ double quaternion_norm(const float* q) {
 
 uint8_t to_byte(double value) {
   return uint8_t(std::clamp(std::lround(value), 0L, 255L));
+}
+
+float opacity_logit_of_byte(uint8_t byte) {
+  return float(logit(std::clamp(double(byte), 0.5, 254.5) / 255));
 }
 
 }  // namespace iesrgs

@@ -19,4 +19,8 @@ double quaternion_norm(const float* q);
 // The nearest integer in 0..255.
 uint8_t to_byte(double value);
 
+// The opacity logit a byte of sigmoid(opacity) * 255 stands for; bytes 0 and 255, whose logits
+// would be -inf and +inf, are taken half a step inside.
+float opacity_logit_of_byte(uint8_t byte);
+
 }  // namespace iesrgs

@@ -5,9 +5,13 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 
+#include "core/math.hpp"
 #include "io/atomic_file.hpp"
+#include "io/model_file.hpp"
+#include "io/viewer_cloud.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -101,6 +105,67 @@ TEST(SplatFile, NonFiniteOrMalformedCloudsAreErrorsAndWriteNothing) {
       << short_array;
   EXPECT_FALSE(std::filesystem::exists(dir / "a.splat"));
   EXPECT_FALSE(std::filesystem::exists(dir / "b.splat"));
+}
+
+// One record's 32 bytes from its fields.
+std::string encode(const Record& r) {
+  std::string bytes(kSplatRecordBytes, '\0');
+  std::memcpy(&bytes[0], r.position.data(), 12);
+  std::memcpy(&bytes[12], r.scale.data(), 12);
+  std::memcpy(&bytes[24], r.rgba.data(), 4);
+  std::memcpy(&bytes[28], r.rotation.data(), 4);
+  return bytes;
+}
+
+TEST(SplatFile, ReadsBackWhatItWroteWithinTheFormatsSteps) {
+  TempDir dir;
+  const SplatCloud written = two_gaussians();
+  write_splat(dir / "scene.SPLAT", written);
+  const SplatCloud read = read_model(dir / "scene.SPLAT");  // by its extension, in any case
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read.sh_degree, 0);
+  EXPECT_TRUE(read.sh_rest.empty());
+  EXPECT_FALSE(read.antialiased);  // drawn as the viewers draw it
+  EXPECT_FALSE(read.has_filter_3d());
+  for (size_t i = 0; i < 2; ++i) {
+    const size_t from = 1 - i;  // the file holds the big opaque Gaussian first
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(read.positions[3 * i + k], written.positions[3 * from + k]);
+      EXPECT_NEAR(read.log_scales[3 * i + k], written.log_scales[3 * from + k], 1e-6);
+      EXPECT_NEAR(0.5 + kShC0 * read.sh_dc[3 * i + k], 0.5 + kShC0 * written.sh_dc[3 * from + k],
+                  0.5 / 255 + 1e-6);
+    }
+    EXPECT_NEAR(sigmoid(read.opacity[i]), sigmoid(written.opacity[from]), 0.5 / 255 + 1e-6);
+    const double norm = quaternion_norm(&written.rotations[4 * from]);
+    for (int k = 0; k < 4; ++k)
+      EXPECT_NEAR(read.rotations[4 * i + k], written.rotations[4 * from + k] / norm, 1.0 / 128);
+  }
+}
+
+TEST(SplatFile, DegenerateRecordsAreMadeUsable) {
+  Record r{{1, 2, 3}, {0, 1, 1}, {0, 0, 0, 255}, {128, 128, 128, 128}};
+  const SplatCloud cloud = parse_splat(encode(r), "z.splat");
+  EXPECT_EQ(cloud.log_scales[0], std::log(std::numeric_limits<float>::min()));  // not -inf
+  EXPECT_EQ(cloud.rotations, (std::vector<float>{1, 0, 0, 0}));                 // identity
+  EXPECT_TRUE(std::isfinite(cloud.opacity[0]));  // byte 255 is not a logit of +inf
+  EXPECT_GT(sigmoid(cloud.opacity[0]), 0.99);
+}
+
+TEST(SplatFile, MalformedFilesAreErrorsNamingTheFile) {
+  const Record good{{1, 2, 3}, {1, 1, 1}, {9, 9, 9, 9}, {255, 128, 128, 128}};
+  EXPECT_TRUE(contains(error_message([] { parse_splat("", "e.splat"); }),
+                       "e.splat: is empty: no Gaussians"));
+  EXPECT_TRUE(contains(error_message([&] { parse_splat(encode(good) + "x", "t.splat"); }),
+                       "t.splat: is 33 bytes, not a whole number of 32-byte .splat records"));
+  Record nan = good;
+  nan.position[1] = NAN;
+  EXPECT_TRUE(contains(error_message([&] { parse_splat(encode(good) + encode(nan), "n.splat"); }),
+                       "n.splat: record 1: position nan is not finite"));
+  Record negative = good;
+  negative.scale[2] = -1;
+  EXPECT_TRUE(contains(error_message([&] { parse_splat(encode(negative), "s.splat"); }),
+                       "s.splat: record 0: scale -1 is not a positive number"));
+  EXPECT_TRUE(contains(error_message([&] { read_splat("/nonexistent/m.splat"); }), "m.splat"));
 }
 
 }  // namespace
