@@ -29,8 +29,9 @@ command -v "${CXX:-clang++}" >/dev/null || "$root/scripts/apt-install.sh" clang 
 
 targets=()
 for name in "${names[@]}"; do targets+=("iesrgs_${name}_fuzzer"); done
+# The parsers need no CUDA kernels (and nvcc may not take this clang as its host compiler).
 CXX=${CXX:-clang++} cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DIESRGS_FUZZ=ON -DIESRGS_TESTS=OFF -DIESRGS_BENCH=OFF >/dev/null
+  -DIESRGS_FUZZ=ON -DIESRGS_TESTS=OFF -DIESRGS_BENCH=OFF -DIESRGS_CUDA=OFF >/dev/null
 cmake --build "$build" -j"${JOBS:-2}" --target "${targets[@]}"
 
 status=0
