@@ -18,7 +18,7 @@ void add_external_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 
-// A trained model given as its training folder (its point_cloud.ply), a .ply or an .spz file.
+// A trained model given as its training folder (its point_cloud.ply) or a model file.
 inline std::filesystem::path model_file(const std::filesystem::path& path) {
   return std::filesystem::is_directory(path) ? path / "point_cloud.ply" : path;
 }

@@ -9,6 +9,7 @@
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
 #include "io/model_file.hpp"
+#include "io/scene.hpp"
 #include "io/view_images.hpp"
 
 namespace iesrgs::cli {
@@ -92,7 +93,7 @@ void add_info_command(CLI::App& app) {
   auto* command =
       app.add_subcommand("info",
                          "Print a scene's cameras, image size, splits, points and extent, or a "
-                         "trained model's (.ply, .spz, .splat) Gaussians");
+                         "trained model's (training folder, .ply, .spz, .splat) Gaussians");
   auto args = std::make_shared<SceneArgs>();
   auto load_images = std::make_shared<bool>(false);
   args->add_to(*command);
@@ -100,8 +101,11 @@ void add_info_command(CLI::App& app) {
                     "Also decode every image (undistorted and resized as training would) and "
                     "fail on the first bad one");
   command->callback([args, load_images] {
-    if (is_model_file(args->path)) {
-      print_model_summary(args->path);
+    const std::filesystem::path path = args->path;
+    const bool training_folder =
+        !is_scene(path) && std::filesystem::exists(path / "point_cloud.ply");
+    if (is_model_file(path) || training_folder) {
+      print_model_summary(model_file(path));
       return;
     }
     const Scene scene = load_scene(args->path, args->resolved());

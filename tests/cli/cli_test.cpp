@@ -128,6 +128,13 @@ TEST(Cli, InfoOfAModelSummarizesItsGaussians) {
   EXPECT_TRUE(contains(run.output, "(-1.000, -4.000, 2.000) to (3.000, 0.000, 5.000)"))
       << run.output;
   EXPECT_TRUE(contains(run.output, "opacity     median 0.500")) << run.output;
+
+  // A training folder is summarized by its point_cloud.ply.
+  std::filesystem::create_directories(dir / "run");
+  std::filesystem::rename(dir / "model.ply", dir / "run" / "point_cloud.ply");
+  const CliRun folder = iesrgs("info " + (dir / "run").string());
+  EXPECT_EQ(folder.status, 0) << folder.output;
+  EXPECT_TRUE(contains(folder.output, "point_cloud.ply\ngaussians   2\n")) << folder.output;
 }
 
 TEST(Cli, EvalCompositesRgbaRendersOverTheBackground) {
