@@ -5,20 +5,13 @@
 #include <cstdint>
 #include <vector>
 
+#include "loss/benchmark_image.hpp"
 #include "loss/photometric.hpp"
 #include "loss/ssim.hpp"
 #include "loss/texture_fusion.hpp"
 
 namespace iesrgs::loss {
 namespace {
-
-// Content does not change the cost; a fixed pattern keeps runs comparable.
-std::vector<float> pattern(const ImageShape& shape, uint32_t seed) {
-  std::vector<float> image(shape.values());
-  for (size_t i = 0; i < image.size(); ++i)
-    image[i] = float(((i + seed) * 2654435761u) >> 8) / 16777216.f;
-  return image;
-}
 
 // Arguments: side (square RGB image), OpenMP threads.
 struct SsimCase {
@@ -27,8 +20,8 @@ struct SsimCase {
 
   explicit SsimCase(const benchmark::State& state)
       : shape{int(state.range(0)), int(state.range(0)), 3},
-        x(pattern(shape, 1)),
-        y(pattern(shape, 2)) {
+        x(benchmark_image(shape, 1)),
+        y(benchmark_image(shape, 2)) {
     omp_set_num_threads(int(state.range(1)));
   }
 };
@@ -89,7 +82,7 @@ std::vector<float> outline_mask(const ImageShape& shape) {
 // row) or mask-guided (Arguments: side, threads, masked).
 void BM_GuidedTexture(benchmark::State& state) {
   SsimCase c(state);
-  const std::vector<float> render = pattern(c.shape, 3);
+  const std::vector<float> render = benchmark_image(c.shape, 3);
   const std::vector<float> share =
       state.range(2) ? outline_mask(c.shape) : std::vector<float>(c.shape.pixels(), 0.f);
   std::vector<float> grad(c.shape.values());

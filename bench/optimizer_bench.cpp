@@ -3,24 +3,12 @@
 #include <benchmark/benchmark.h>
 #include <torch/torch.h>
 
+#include "gs/benchmark_model.hpp"
 #include "gs/densify.hpp"
 #include "gs/optimizer.hpp"
 
 namespace iesrgs::gs {
 namespace {
-
-GaussianModel random_model(int64_t n) {
-  torch::manual_seed(1);
-  GaussianModel model;
-  model.set_params({torch::randn({n, 3}), torch::rand({n, 1, 3}), torch::zeros({n, 15, 3}),
-                    torch::zeros({n}), torch::full({n, 3}, -4.0f), torch::randn({n, 4})});
-  return model;
-}
-
-void fill_gradients(GaussianModel& model) {
-  for (int p = 0; p < kParamCount; ++p)
-    model.param(Param(p)).mutable_grad() = torch::randn_like(model.param(Param(p))) * 1e-3;
-}
 
 // Through LibTorch, whose first operation on a thread would otherwise set OpenMP's thread count
 // back to its own default (one thread with Debian's build).
@@ -31,9 +19,8 @@ void use_threads(int64_t threads) {
 // Args: Gaussians, OpenMP threads.
 void BM_AdamStep(benchmark::State& state) {
   use_threads(state.range(1));
-  GaussianModel model = random_model(state.range(0));
+  GaussianModel model = benchmark_model(state.range(0));
   GaussianOptimizer optimizer(model, LearningRates{}, 4.0);
-  fill_gradients(model);
   for (auto _ : state) optimizer.step(model);
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }

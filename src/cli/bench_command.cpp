@@ -14,8 +14,10 @@
 #include "cli/commands.hpp"
 #include "core/error.hpp"
 #include "core/math.hpp"
+#include "gs/benchmark_model.hpp"
 #include "gs/optimizer.hpp"
 #include "gs/sh.hpp"
+#include "loss/benchmark_image.hpp"
 #include "loss/ssim.hpp"
 #include "raster/cpu/dispatch.hpp"
 #include "raster/rasterizer.hpp"
@@ -132,20 +134,12 @@ void run_raster_bench(const RasterBenchArgs& args) {
   fmt::print("cpu time, forward+backward: {:.1f} ms over all threads\n", total.cpu_ms);
 }
 
-// Content does not change the cost; a fixed pattern keeps runs comparable.
-std::vector<float> pattern(size_t count, uint32_t seed) {
-  std::vector<float> values(count);
-  for (size_t i = 0; i < count; ++i)
-    values[i] = float(((i + seed) * 2654435761u) >> 8) / 16777216.f;
-  return values;
-}
-
 void run_ssim_bench(const SsimBenchArgs& args) {
   if (args.width <= 0 || args.height <= 0)
     fail("bench ssim: --width and --height must be positive");
   apply(args.run, "ssim");
   const loss::ImageShape shape{args.height, args.width, 3};
-  const std::vector<float> x = pattern(shape.values(), 1), y = pattern(shape.values(), 2);
+  const std::vector<float> x = loss::benchmark_image(shape, 1), y = loss::benchmark_image(shape, 2);
   std::vector<float> partials(loss::ssim_partials_size(shape)), grad(shape.values());
   const std::vector<float> weight(shape.pixels(), 1.f / float(shape.pixels()));
   const Medians forward = time_runs(args.run.iterations, [&](int) {
@@ -169,16 +163,9 @@ void run_adam_bench(const AdamBenchArgs& args) {
   if (args.gaussians <= 0) fail("bench adam: --gaussians must be positive");
   apply(args.run, "adam");
   const int64_t n = args.gaussians;
-  torch::manual_seed(1);
-  gs::GaussianModel model;
-  model.set_params({torch::randn({n, 3}), torch::rand({n, 1, 3}), torch::zeros({n, 15, 3}),
-                    torch::zeros({n}), torch::full({n, 3}, -4.0f), torch::randn({n, 4})});
+  gs::GaussianModel model = gs::benchmark_model(n);
   int64_t floats = 0;
-  for (int p = 0; p < gs::kParamCount; ++p) {
-    torch::Tensor& param = model.param(gs::Param(p));
-    param.mutable_grad() = torch::randn_like(param) * 1e-3;
-    floats += param.numel();
-  }
+  for (int p = 0; p < gs::kParamCount; ++p) floats += model.param(gs::Param(p)).numel();
   gs::GaussianOptimizer optimizer(model, gs::LearningRates{}, 4.0);
   const Medians step = time_runs(args.run.iterations, [&](int) { optimizer.step(model); });
   // Each float: parameter, gradient and both moments read, parameter and moments written.
