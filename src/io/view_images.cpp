@@ -42,6 +42,18 @@ std::string undistort_key(const std::string& source_digest, const Intrinsics& k,
                   k.width, k.height, k.fx, k.fy, k.cx, k.cy, d.k1, d.k2, d.p1, d.p2));
 }
 
+// Where a camera's size came from, for the error of an image that does not match it. A
+// NeRF-Synthetic split has one camera angle, and its size is that of the split's first image,
+// which may be the odd one out.
+std::string size_origin(const Scene& scene, const Camera& camera) {
+  if (scene.format == "blender")
+    for (const Camera& first : scene.cameras)
+      if (first.split == camera.split)
+        return fmt::format("(the size of {}, the first image of its split: all must match)",
+                           first.image_path.string());
+  return "like the scene's cameras";
+}
+
 }  // namespace
 
 fs::path ViewImageOptions::default_cache_dir() {
@@ -71,8 +83,9 @@ Image8 ViewImages::read_source(const Camera& camera, Intrinsics& source_intrinsi
   }
   Image8 image = read_image8(camera.image_path);
   if (image.width != camera.stored.width || image.height != camera.stored.height)
-    fail_file(camera.image_path, fmt::format("image is {}x{}, expected {} like the scene's cameras",
-                                             image.width, image.height, describe(camera.stored)));
+    fail_file(camera.image_path,
+              fmt::format("image is {}x{}, expected {} {}", image.width, image.height,
+                          describe(camera.stored), size_origin(scene_, camera)));
   source_intrinsics = camera.stored;
   return image;
 }

@@ -98,6 +98,21 @@ TEST(ViewImages, WrongImageSizeNamesTheFile) {
   EXPECT_NE(message.find("a.png: image is 8x6, expected 9x6"), std::string::npos) << message;
 }
 
+// A NeRF-Synthetic split takes its size from its first image: when that one is the odd one out,
+// the error must point at it, not only at the image that failed.
+TEST(ViewImages, WrongSizeInNerfSyntheticNamesTheImageTheSizeCameFrom) {
+  SceneFixture f;
+  f.scene.format = "blender";
+  f.add("r_0.png", solid(8, 6, {1, 2, 3}));
+  Camera second = f.add("r_1.png", solid(9, 6, {1, 2, 3}));
+  second.stored = f.scene.cameras.front().stored;
+  ViewImages images(f.scene, f.options);
+  const std::string message = error_message([&] { images.rgb(second); });
+  EXPECT_NE(message.find("r_1.png: image is 9x6, expected 8x6 (the size of "), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("r_0.png, the first image of its split"), std::string::npos) << message;
+}
+
 TEST(ViewImages, KeepsAtMostTheCacheBudget) {
   SceneFixture f;
   const Camera a = f.add("a.png", solid(4, 4, {1, 2, 3}));
