@@ -54,9 +54,9 @@ double elapsed_ms(Clock::time_point since) {
   return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
 }
 
-struct Medians {
-  double wall_ms = 0;
-  double cpu_ms = 0;  // summed over threads
+struct Timing {
+  double wall_ms = 0;  // median
+  double cpu_ms = 0;   // mean, summed over threads
 };
 
 void apply(const RunArgs& run, const char* command) {
@@ -68,19 +68,20 @@ void apply(const RunArgs& run, const char* command) {
 }
 
 // Runs work(i) for i = -1 (a warm-up that sizes every buffer, not timed) up to iterations - 1.
-// Medians, so that one disturbed run (a shared machine) does not skew the result; on a busy
-// machine wall time overstates the cost, CPU time does not.
-Medians time_runs(int iterations, const std::function<void(int)>& work) {
-  std::vector<double> wall, cpu;
+// The median wall time, so that one disturbed run (a shared machine) does not skew the result;
+// on a busy machine wall time overstates the cost, CPU time does not. CPU time is taken over all
+// runs at once: Linux adds a thread's time running on another core to the process only at that
+// core's scheduler tick, so the runs shorter than a tick would miss it one by one.
+Timing time_runs(int iterations, const std::function<void(int)>& work) {
+  std::vector<double> wall;
+  std::clock_t cpu_start = 0;
   for (int it = -1; it < iterations; ++it) {
+    if (it == 0) cpu_start = std::clock();
     const auto start = Clock::now();
-    const std::clock_t cpu_start = std::clock();
     work(it);
-    if (it < 0) continue;
-    wall.push_back(elapsed_ms(start));
-    cpu.push_back(1000.0 * double(std::clock() - cpu_start) / CLOCKS_PER_SEC);
+    if (it >= 0) wall.push_back(elapsed_ms(start));
   }
-  return {median(wall), median(cpu)};
+  return {median(wall), 1000.0 * double(std::clock() - cpu_start) / CLOCKS_PER_SEC / iterations};
 }
 
 void run_raster_bench(const RasterBenchArgs& args) {
@@ -101,7 +102,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
   const float background[3] = {1, 1, 1};
   RasterFrame<float> frame;
   std::vector<double> forward, project, bin, blend, backward;
-  const Medians total = time_runs(args.run.iterations, [&](int it) {
+  const Timing total = time_runs(args.run.iterations, [&](int it) {
     const auto start = Clock::now();
     rasterize_forward(g, cam, background, frame,
                       RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
@@ -131,7 +132,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
   fmt::print("  binning/sort: {:.1f} ms\n", median(bin));
   fmt::print("  blend: {:.1f} ms\n", median(blend));
   fmt::print("  backward: {:.1f} ms\n", median(backward));
-  fmt::print("cpu time, forward+backward: {:.1f} ms over all threads\n", total.cpu_ms);
+  fmt::print("cpu time, forward+backward: {:.1f} ms over all threads (mean)\n", total.cpu_ms);
 }
 
 void run_ssim_bench(const SsimBenchArgs& args) {
@@ -142,11 +143,11 @@ void run_ssim_bench(const SsimBenchArgs& args) {
   const std::vector<float> x = loss::benchmark_image(shape, 1), y = loss::benchmark_image(shape, 2);
   std::vector<float> partials(loss::ssim_partials_size(shape)), grad(shape.values());
   const std::vector<float> weight(shape.pixels(), 1.f / float(shape.pixels()));
-  const Medians forward = time_runs(args.run.iterations, [&](int) {
+  const Timing forward = time_runs(args.run.iterations, [&](int) {
     loss::ssim<float>(x.data(), y.data(), shape, nullptr, partials.data());
   });
   // What a training step pays: the forward with partials, then the backward of the mean.
-  const Medians total = time_runs(args.run.iterations, [&](int) {
+  const Timing total = time_runs(args.run.iterations, [&](int) {
     loss::ssim<float>(x.data(), y.data(), shape, nullptr, partials.data());
     loss::ssim_backward<float>(x.data(), y.data(), shape, partials.data(), weight.data(),
                                grad.data());
@@ -156,7 +157,7 @@ void run_ssim_bench(const SsimBenchArgs& args) {
   fmt::print("forward (with partials): {:.2f} ms\n", forward.wall_ms);
   fmt::print("forward+backward: {:.2f} ms ({:.1f} Mpixel/s)\n", total.wall_ms,
              double(shape.pixels()) / total.wall_ms / 1e3);
-  fmt::print("cpu time, forward+backward: {:.2f} ms over all threads\n", total.cpu_ms);
+  fmt::print("cpu time, forward+backward: {:.2f} ms over all threads (mean)\n", total.cpu_ms);
 }
 
 void run_adam_bench(const AdamBenchArgs& args) {
@@ -167,14 +168,14 @@ void run_adam_bench(const AdamBenchArgs& args) {
   int64_t floats = 0;
   for (int p = 0; p < gs::kParamCount; ++p) floats += model.param(gs::Param(p)).numel();
   gs::GaussianOptimizer optimizer(model, gs::LearningRates{}, 4.0);
-  const Medians step = time_runs(args.run.iterations, [&](int) { optimizer.step(model); });
+  const Timing step = time_runs(args.run.iterations, [&](int) { optimizer.step(model); });
   // Each float: parameter, gradient and both moments read, parameter and moments written.
   const double bytes = double(floats) * sizeof(float) * 7;
   fmt::print("model: {} Gaussians ({} floats), {} threads, {} iterations (medians)\n", n, floats,
              omp_get_max_threads(), args.run.iterations);
   fmt::print("Adam step: {:.2f} ms ({:.1f} GB/s of parameters, gradients and moments)\n",
              step.wall_ms, bytes / step.wall_ms / 1e6);
-  fmt::print("cpu time: {:.2f} ms over all threads\n", step.cpu_ms);
+  fmt::print("cpu time: {:.2f} ms over all threads (mean)\n", step.cpu_ms);
 }
 
 void add_run_options(CLI::App* command, RunArgs& run) {
