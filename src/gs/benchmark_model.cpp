@@ -2,8 +2,7 @@
 
 namespace iesrgs::gs {
 
-GaussianModel benchmark_model(int64_t count) {
-  const int64_t n = count;
+GaussianModel benchmark_model(int64_t n) {
   torch::manual_seed(1);
   GaussianModel model;
   model.set_params({torch::randn({n, 3}), torch::rand({n, 1, 3}), torch::zeros({n, 15, 3}),

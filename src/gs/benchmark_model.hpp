@@ -7,7 +7,7 @@
 
 namespace iesrgs::gs {
 
-// `count` Gaussians of SH degree 3 with seeded random parameters and a gradient on every one.
-GaussianModel benchmark_model(int64_t count);
+// n Gaussians of SH degree 3 with seeded random parameters and a gradient on every one.
+GaussianModel benchmark_model(int64_t n);
 
 }  // namespace iesrgs::gs
