@@ -27,7 +27,7 @@ namespace iesrgs::cli {
 
 namespace {
 
-struct RunArgs {
+struct RepeatArgs {
   int threads = 0;  // 0: OpenMP's default
   int iterations = 5;
 };
@@ -35,17 +35,17 @@ struct RunArgs {
 struct RasterBenchArgs {
   int gaussians = 100000;
   int width = 800, height = 800;
-  RunArgs run;
+  RepeatArgs repeat;
 };
 
 struct SsimBenchArgs {
   int width = 800, height = 800;
-  RunArgs run{0, 20};
+  RepeatArgs repeat{0, 20};
 };
 
 struct AdamBenchArgs {
   int gaussians = 500000;
-  RunArgs run{0, 20};
+  RepeatArgs repeat{0, 20};
 };
 
 using Clock = std::chrono::steady_clock;
@@ -59,12 +59,12 @@ struct Timing {
   double cpu_ms = 0;   // mean, summed over threads
 };
 
-void apply(const RunArgs& run, const char* command) {
-  if (run.iterations <= 0 || run.threads < 0)
+void apply(const RepeatArgs& repeat, const char* command) {
+  if (repeat.iterations <= 0 || repeat.threads < 0)
     fail("bench {}: --iterations must be positive and --threads not negative", command);
   // Through LibTorch, whose first operation on a thread would otherwise set OpenMP's thread
   // count back to its own.
-  if (run.threads > 0) torch::set_num_threads(run.threads);
+  if (repeat.threads > 0) torch::set_num_threads(repeat.threads);
 }
 
 // Runs work(i) for i = -1 (a warm-up that sizes every buffer, not timed) up to iterations - 1.
@@ -87,7 +87,7 @@ Timing time_runs(int iterations, const std::function<void(int)>& work) {
 void run_raster_bench(const RasterBenchArgs& args) {
   if (args.gaussians < 0 || args.width <= 0 || args.height <= 0)
     fail("bench raster: --width and --height must be positive, --gaussians not negative");
-  apply(args.run, "raster");
+  apply(args.repeat, "raster");
   using namespace raster;
   const RasterCamera<float> cam = benchmark_camera(args.width, args.height);
   const GaussianCloud cloud = synthetic_scene(args.gaussians, cam, 1);
@@ -102,7 +102,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
   const float background[3] = {1, 1, 1};
   RasterFrame<float> frame;
   std::vector<double> forward, project, bin, blend, backward;
-  const Timing total = time_runs(args.run.iterations, [&](int it) {
+  const Timing total = time_runs(args.repeat.iterations, [&](int it) {
     const auto start = Clock::now();
     rasterize_forward(g, cam, background, frame,
                       RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
@@ -124,7 +124,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
       "scene: {} Gaussians ({} drawn), {}x{}, {} tile entries, {} threads, {} iterations "
       "(medians)\n",
       n, drawn, args.width, args.height, frame.bins.entry_count(), omp_get_max_threads(),
-      args.run.iterations);
+      args.repeat.iterations);
   fmt::print("blend kernels: {}\n", cpu::describe_isa(cpu::active_isa()));
   fmt::print("forward: {:.1f} ms\n", median(forward));
   fmt::print("forward+backward: {:.1f} ms\n", total.wall_ms);
@@ -138,22 +138,22 @@ void run_raster_bench(const RasterBenchArgs& args) {
 void run_ssim_bench(const SsimBenchArgs& args) {
   if (args.width <= 0 || args.height <= 0)
     fail("bench ssim: --width and --height must be positive");
-  apply(args.run, "ssim");
+  apply(args.repeat, "ssim");
   const loss::ImageShape shape{args.height, args.width, 3};
   const std::vector<float> x = loss::benchmark_image(shape, 1), y = loss::benchmark_image(shape, 2);
   std::vector<float> partials(loss::ssim_partials_size(shape)), grad(shape.values());
   const std::vector<float> weight(shape.pixels(), 1.f / float(shape.pixels()));
-  const Timing forward = time_runs(args.run.iterations, [&](int) {
+  const Timing forward = time_runs(args.repeat.iterations, [&](int) {
     loss::ssim<float>(x.data(), y.data(), shape, nullptr, partials.data());
   });
   // What a training step pays: the forward with partials, then the backward of the mean.
-  const Timing total = time_runs(args.run.iterations, [&](int) {
+  const Timing total = time_runs(args.repeat.iterations, [&](int) {
     loss::ssim<float>(x.data(), y.data(), shape, nullptr, partials.data());
     loss::ssim_backward<float>(x.data(), y.data(), shape, partials.data(), weight.data(),
                                grad.data());
   });
   fmt::print("image: {}x{} RGB, {} threads, {} iterations (medians)\n", args.width, args.height,
-             omp_get_max_threads(), args.run.iterations);
+             omp_get_max_threads(), args.repeat.iterations);
   fmt::print("forward (with partials): {:.2f} ms\n", forward.wall_ms);
   fmt::print("forward+backward: {:.2f} ms ({:.1f} Mpixel/s)\n", total.wall_ms,
              double(shape.pixels()) / total.wall_ms / 1e3);
@@ -162,25 +162,25 @@ void run_ssim_bench(const SsimBenchArgs& args) {
 
 void run_adam_bench(const AdamBenchArgs& args) {
   if (args.gaussians <= 0) fail("bench adam: --gaussians must be positive");
-  apply(args.run, "adam");
+  apply(args.repeat, "adam");
   const int64_t n = args.gaussians;
   gs::GaussianModel model = gs::benchmark_model(n);
   int64_t floats = 0;
   for (int p = 0; p < gs::kParamCount; ++p) floats += model.param(gs::Param(p)).numel();
   gs::GaussianOptimizer optimizer(model, gs::LearningRates{}, 4.0);
-  const Timing step = time_runs(args.run.iterations, [&](int) { optimizer.step(model); });
+  const Timing step = time_runs(args.repeat.iterations, [&](int) { optimizer.step(model); });
   // Each float: parameter, gradient and both moments read, parameter and moments written.
   const double bytes = double(floats) * sizeof(float) * 7;
   fmt::print("model: {} Gaussians ({} floats), {} threads, {} iterations (medians)\n", n, floats,
-             omp_get_max_threads(), args.run.iterations);
+             omp_get_max_threads(), args.repeat.iterations);
   fmt::print("Adam step: {:.2f} ms ({:.1f} GB/s of parameters, gradients and moments)\n",
              step.wall_ms, bytes / step.wall_ms / 1e6);
   fmt::print("cpu time: {:.2f} ms over all threads (mean)\n", step.cpu_ms);
 }
 
-void add_run_options(CLI::App* command, RunArgs& run) {
-  command->add_option("--threads", run.threads, "OpenMP threads (default: all cores)");
-  command->add_option("--iterations", run.iterations, "Timed iterations")->capture_default_str();
+void add_repeat_options(CLI::App* command, RepeatArgs& repeat) {
+  command->add_option("--threads", repeat.threads, "OpenMP threads (default: all cores)");
+  command->add_option("--iterations", repeat.iterations, "Timed iterations")->capture_default_str();
 }
 
 void add_image_size(CLI::App* command, int& width, int& height) {
@@ -199,20 +199,20 @@ void add_bench_command(CLI::App& app) {
   raster->add_option("--gaussians", raster_args->gaussians, "Number of Gaussians")
       ->capture_default_str();
   add_image_size(raster, raster_args->width, raster_args->height);
-  add_run_options(raster, raster_args->run);
+  add_repeat_options(raster, raster_args->repeat);
   raster->callback([raster_args] { run_raster_bench(*raster_args); });
 
   auto* ssim = bench->add_subcommand("ssim", "Time the SSIM loss kernel, forward and backward");
   auto ssim_args = std::make_shared<SsimBenchArgs>();
   add_image_size(ssim, ssim_args->width, ssim_args->height);
-  add_run_options(ssim, ssim_args->run);
+  add_repeat_options(ssim, ssim_args->repeat);
   ssim->callback([ssim_args] { run_ssim_bench(*ssim_args); });
 
   auto* adam = bench->add_subcommand("adam", "Time the optimizer step over every parameter");
   auto adam_args = std::make_shared<AdamBenchArgs>();
   adam->add_option("--gaussians", adam_args->gaussians, "Number of Gaussians")
       ->capture_default_str();
-  add_run_options(adam, adam_args->run);
+  add_repeat_options(adam, adam_args->repeat);
   adam->callback([adam_args] { run_adam_bench(*adam_args); });
 }
 

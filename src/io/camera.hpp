@@ -10,6 +10,10 @@ namespace iesrgs {
 
 enum class Split { Train, Test };
 
+// The largest image side a scene file may declare: larger is a corrupt value, not an image anyone
+// trains on, and would drive huge allocations and overflow int pixel counts.
+constexpr int kMaxImageSide = 1 << 16;
+
 const char* split_name(Split split);
 
 // Lens distortion of the stored image, in the OpenCV / COLMAP model

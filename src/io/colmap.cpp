@@ -103,9 +103,6 @@ void write_colmap_model_text(const fs::path& dir, const ColmapModel& model) {
 
 namespace {
 
-// Larger is a corrupt file, not a photograph (and would overflow int pixel counts).
-constexpr uint64_t kMaxImageSide = 1 << 16;
-
 // Where the pinhole and distortion terms sit in a supported model's parameters; -1: the model
 // has no such term (zero). The SIMPLE_ models share one focal length between x and y.
 struct PinholeLayout {
@@ -143,8 +140,8 @@ struct Lens {
 Lens lens_of(const ColmapCamera& camera, const fs::path& cameras_file) {
   const PinholeLayout& layout = supported_layout(camera, cameras_file);
   const auto param = [&camera](int index) { return index < 0 ? 0.0 : camera.params[index]; };
-  if (camera.width < 1 || camera.width > kMaxImageSide || camera.height < 1 ||
-      camera.height > kMaxImageSide)
+  if (camera.width < 1 || camera.width > uint64_t(kMaxImageSide) || camera.height < 1 ||
+      camera.height > uint64_t(kMaxImageSide))
     fail_file(cameras_file, fmt::format("camera {}: implausible image size {}x{}", camera.id,
                                         camera.width, camera.height));
   Lens lens;

@@ -17,8 +17,6 @@ using nlohmann::json;
 
 namespace {
 
-// Larger sides are corrupt values, not images anyone trains on; they would drive huge allocations.
-constexpr int kMaxImageSide = 1 << 16;
 // Poses are stored as text with float precision; real files are orthonormal to about 1e-6.
 constexpr double kRotationTolerance = 1e-3;
 

@@ -1,16 +1,12 @@
 #include <gtest/gtest.h>
 
 #include "io/camera.hpp"
+#include "support/projection.hpp"
 
 namespace iesrgs {
 namespace {
 
-// Pixel coordinates of a world point (pixel centers at +0.5).
-std::pair<double, double> project(const Camera& camera, const Vec3& world) {
-  const Vec3 p = camera.rotation * world + camera.translation;
-  const Intrinsics& k = camera.intrinsics;
-  return {k.fx * p.x / p.z + k.cx, k.fy * p.y / p.z + k.cy};
-}
+using testing::project;
 
 TEST(Camera, OpenGlCameraToWorldBecomesOpenCvWorldToCamera) {
   // An OpenGL camera at (0, 0, 4) looking down -z at the origin, y up.

@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "support/expect_error.hpp"
+#include "support/projection.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs {
@@ -18,15 +19,9 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using testing::error_message;
+using testing::project;
 using testing::TempDir;
 using testing::write_text;
-
-// Pixel coordinates of a world point (pixel centers at +0.5).
-std::pair<double, double> project(const Camera& camera, const Vec3& world) {
-  const Vec3 p = camera.rotation * world + camera.translation;
-  const Intrinsics& k = camera.intrinsics;
-  return {k.fx * p.x / p.z + k.cx, k.fy * p.y / p.z + k.cy};
-}
 
 // OpenGL camera-to-world: a camera at `center` with identity orientation (looking down -z).
 json identity_pose(double x, double y, double z) {
