@@ -56,6 +56,17 @@ train::TrainConfig resolve_config(const TrainArgs& args, const std::filesystem::
   return config;
 }
 
+// The saved config is the run's identity: an option that would change it cannot take effect.
+void refuse_changes_on_resume(const CLI::App& command) {
+  for (const char* name :
+       {"--preset", "--iterations", "--mv", "--seed", "--config", "--set", "--init-ply"})
+    if (command.get_option(name)->count() > 0)
+      fail(
+          "{} cannot change a resumed run: --resume continues with the config saved in the output "
+          "folder (train into a new folder for other settings)",
+          name);
+}
+
 void run_train(const TrainArgs& args) {
   const std::filesystem::path out = args.output;
   const train::TrainConfig config = resolve_config(args, out / "config.json");
@@ -114,7 +125,10 @@ void add_train_command(CLI::App& app) {
   command->add_option("--init-ply", args->init_ply,
                       "Start from this 3DGS .ply, .spz or .splat instead");
   command->add_flag("--resume", args->resume, "Continue the run in --output from its checkpoint");
-  command->callback([args] { run_train(*args); });
+  command->callback([args, command] {
+    if (args->resume) refuse_changes_on_resume(*command);
+    run_train(*args);
+  });
 }
 
 }  // namespace iesrgs::cli

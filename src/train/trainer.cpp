@@ -93,9 +93,9 @@ std::filesystem::path Trainer::checkpoint_path() const {
   return setup_.output_dir / "checkpoint.pt";
 }
 
-void Trainer::save_checkpoint(double loss) {
+void Trainer::save_checkpoint() {
   // Never replace a good checkpoint with a broken model.
-  if (!all_finite(model_)) fail_diverged(iteration_, loss);
+  if (!all_finite(model_)) fail_diverged(iteration_, last_loss_);
   std::ostringstream view_rng;
   view_rng << view_rng_;
   torch::Tensor torch_rng;
@@ -108,7 +108,9 @@ void Trainer::save_checkpoint(double loss) {
                           {{"iteration", torch::tensor(iteration_)},
                            {"view_rng", bytes_tensor(view_rng.str())},
                            {"torch_rng", torch_rng},
-                           {"seconds", torch::tensor(training_seconds(), torch::kFloat64)}});
+                           {"seconds", torch::tensor(training_seconds(), torch::kFloat64)},
+                           {"loss", torch::tensor(last_loss_, torch::kFloat64)},
+                           {"test_psnr", torch::tensor(last_test_psnr_, torch::kFloat64)}});
   checkpoint_iteration_ = iteration_;
 }
 
@@ -116,14 +118,20 @@ void Trainer::resume() {
   const std::filesystem::path path = checkpoint_path();
   if (!std::filesystem::exists(path))
     fail_file(path, "no checkpoint to resume from (train without --resume first)");
-  gs::CheckpointExtras extras{
-      {"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}}, {"seconds", {}}};
+  gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}},
+                              {"seconds", {}},   {"loss", {}},     {"test_psnr", {}}};
   gs::load_training_state(path, model_, *optimizer_, stats_, &extras);
   for (const char* required : {"iteration", "view_rng", "torch_rng"})
     if (!extras[required].defined())
       fail_file(path, fmt::format("not a training checkpoint of iesrgs train (no {})", required));
   iteration_ = extras["iteration"].item<int64_t>();
-  seconds_before_ = extras["seconds"].defined() ? extras["seconds"].item<double>() : 0;
+  // Checkpoints of older versions lack these.
+  const auto stored = [&](const char* name) {
+    return extras[name].defined() ? extras[name].item<double>() : 0.0;
+  };
+  seconds_before_ = stored("seconds");
+  last_loss_ = stored("loss");
+  last_test_psnr_ = stored("test_psnr");
   std::istringstream view_rng(tensor_bytes(extras["view_rng"]));
   view_rng >> view_rng_;
   if (!view_rng) fail_file(path, "the stored view sampler state is corrupt");
@@ -241,28 +249,27 @@ TrainSummary Trainer::run() {
   ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations);
   write_cameras_json(setup_.output_dir / "cameras.json", train_cameras_);
   run_start_ = std::chrono::steady_clock::now();
-  const int64_t first = iteration_;
-  double loss = 0;
   while (iteration_ < config_.iterations) {
-    loss = step(iteration_ + 1);
+    last_loss_ = step(iteration_ + 1);
     ++iteration_;
     const bool last = iteration_ == config_.iterations;
     // The parameters are checked after the optimizer step, and not every step (a reduction over
     // the whole model): a divergence shows within 100 iterations and never reaches the outputs.
-    if ((iteration_ % 100 == 0 || last) && !all_finite(model_)) fail_diverged(iteration_, loss);
+    if ((iteration_ % 100 == 0 || last) && !all_finite(model_))
+      fail_diverged(iteration_, last_loss_);
     std::optional<double> test_psnr;
     if (!setup_.test_views.empty() && config_.test_every > 0 &&
         (iteration_ % config_.test_every == 0 || last)) {
       test_psnr = report_test_psnr();
-      summary.test_psnr = *test_psnr;
+      last_test_psnr_ = *test_psnr;
     }
     // After the report: an opacity reset on the same iteration would make it read ~12 dB.
     densify(iteration_);
-    log.record(iteration_, loss, model_.size(), test_psnr, last);
+    log.record(iteration_, last_loss_, model_.size(), test_psnr, last);
     const bool interrupted = interrupt_requested.load();
     if (last || interrupted ||
         (config_.checkpoint_every > 0 && iteration_ % config_.checkpoint_every == 0))
-      save_checkpoint(loss);
+      save_checkpoint();
     if (interrupted) {
       fmt::print("interrupted: checkpoint of iteration {} saved to {}; continue with --resume\n",
                  iteration_, checkpoint_path().string());
@@ -272,9 +279,9 @@ TrainSummary Trainer::run() {
   }
   summary.seconds = training_seconds();
   summary.iterations = iteration_;
-  const double this_run = summary.seconds - seconds_before_;
-  summary.iterations_per_second = this_run > 0 ? double(iteration_ - first) / this_run : 0;
-  summary.final_loss = loss;
+  summary.iterations_per_second = summary.seconds > 0 ? double(iteration_) / summary.seconds : 0;
+  summary.final_loss = last_loss_;
+  summary.test_psnr = last_test_psnr_;
   summary.gaussians = model_.size();
   return summary;
 }

@@ -38,10 +38,10 @@ struct TrainerSetup {
 };
 
 struct TrainSummary {
-  int64_t iterations = 0;    // completed in total (including before a resume)
-  bool interrupted = false;  // stopped by SIGINT after saving a checkpoint
-  double seconds = 0;        // of training, the runs before a resume included
-  double iterations_per_second = 0;
+  int64_t iterations = 0;            // completed in total (including before a resume)
+  bool interrupted = false;          // stopped by SIGINT after saving a checkpoint
+  double seconds = 0;                // of training, the runs before a resume included
+  double iterations_per_second = 0;  // iterations / seconds
   double final_loss = 0;
   double test_psnr = 0;  // last report; 0 without test views
   int64_t gaussians = 0;
@@ -70,7 +70,7 @@ class Trainer {
   double step(int64_t iteration);  // one optimizer step; returns the loss
   std::vector<int> pick_views();
   void densify(int64_t iteration);
-  void save_checkpoint(double loss);  // of the last step, for the error when diverged
+  void save_checkpoint();
   [[noreturn]] void fail_diverged(int64_t iteration, double loss) const;
   double report_test_psnr();
   double training_seconds() const;
@@ -85,6 +85,10 @@ class Trainer {
   int64_t iteration_ = 0;              // completed iterations
   int64_t checkpoint_iteration_ = -1;  // of the last checkpoint written or read
   double seconds_before_ = 0;          // training time of the runs before a resume
+  // The last step's loss and test report, checkpointed so that resuming a finished run reports
+  // them rather than zeros.
+  double last_loss_ = 0;
+  double last_test_psnr_ = 0;
   std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now();
 };
 

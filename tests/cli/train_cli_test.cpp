@@ -106,15 +106,31 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
       << unknown.output;
 }
 
-TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModel) {
+TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   TempDir dir;
   const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
   ASSERT_EQ(iesrgs("synth -o " + scene + " --size 24 --views 4 --test-views 1").status, 0);
-  const std::string args = "train " + scene + " -o " + out + " --preset fast --iterations 10";
-  ASSERT_EQ(iesrgs(args + " --set random_points=500 --set init=random").status, 0);
-  const CliRun resumed = iesrgs(args + " --resume");
+  const std::string train = "train " + scene + " -o " + out;
+  ASSERT_EQ(
+      iesrgs(train + " --preset fast --iterations 10 --set random_points=500 --set init=random")
+          .status,
+      0);
+  const auto report = nlohmann::json::parse(read_file(dir / "run" / "training.json"));
+  const std::string model = read_file(dir / "run" / "point_cloud.ply");
+  const CliRun resumed = iesrgs(train + " --resume");
   ASSERT_EQ(resumed.status, 0) << resumed.output;
   EXPECT_TRUE(contains(resumed.output, "resuming")) << resumed.output;
+  EXPECT_EQ(read_file(dir / "run" / "point_cloud.ply"), model);
+  const auto again = nlohmann::json::parse(read_file(dir / "run" / "training.json"));
+  for (const char* key : {"iterations", "gaussians", "final_loss", "test_psnr"})
+    EXPECT_EQ(again[key], report[key]) << key;
+  EXPECT_GT(again["test_psnr"].get<double>(), 0.0);
+  EXPECT_GT(again["iterations_per_second"].get<double>(), 0.0);
+
+  const CliRun longer = iesrgs(train + " --resume --iterations 20");
+  EXPECT_EQ(longer.status, 1);
+  EXPECT_TRUE(contains(last_line(longer.output), "--iterations cannot change a resumed run"))
+      << longer.output;
 }
 
 TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {
