@@ -45,6 +45,7 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
     spdlog::info("starting from {} SfM points", scene.points.positions.size());
     return gs::model_from_point_cloud(scene.points);
   }
+  require_training_memory(config.random_points);
   spdlog::info("starting from {} random points in [-{}, {}]^3", config.random_points,
                config.random_extent, config.random_extent);
   return gs::model_from_random_box(config.random_points, config.random_extent, config.seed);

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/memory.hpp"
 #include "eval/metrics.hpp"
 #include "gs/checkpoint.hpp"
 #include "gs/densify.hpp"
@@ -75,9 +76,18 @@ bool all_finite(const gs::GaussianModel& model) {
 
 }  // namespace
 
+void require_training_memory(int64_t gaussians) {
+  // Parameters, gradients, Adam moments, densification statistics and the per-view projection
+  // buffers: the peak resident memory grows by about 1.4 KB per Gaussian (measured from 0.1M to
+  // 3M random points).
+  constexpr int64_t kBytesPerGaussian = 1400;
+  require_memory(gaussians * kBytesPerGaussian, fmt::format("training {} Gaussians", gaussians));
+}
+
 Trainer::Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianModel initial)
     : config_(config), setup_(std::move(setup)), model_(std::move(initial)) {
   validate(config_);
+  require_training_memory(model_.size());
   if (setup_.train_views.empty()) fail("training needs at least one view");
   for (const TrainView& view : setup_.train_views) train_cameras_.push_back(view.camera);
   torch::manual_seed(config_.seed);

@@ -37,6 +37,9 @@ struct TrainerSetup {
   ViewLoss loss;                     // empty: the photometric default
 };
 
+// Fails up front when training `gaussians` Gaussians would not fit in the available memory.
+void require_training_memory(int64_t gaussians);
+
 struct TrainSummary {
   int64_t iterations = 0;            // completed in total (including before a resume)
   bool interrupted = false;          // stopped by SIGINT after saving a checkpoint

@@ -145,6 +145,11 @@ TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {
   const CliRun resume = iesrgs("train " + scene + " -o " + (dir / "b").string() + " --resume");
   EXPECT_EQ(resume.status, 1);
   EXPECT_TRUE(contains(last_line(resume.output), "config.json: missing")) << resume.output;
+  const CliRun huge = iesrgs("train " + scene + " -o " + (dir / "c").string() +
+                             " --set init=random --set random_points=2000000000");
+  EXPECT_EQ(huge.status, 1);
+  EXPECT_TRUE(contains(last_line(huge.output), "not enough memory: training 2000000000 Gaussians"))
+      << huge.output;
   const CliRun model = iesrgs("render " + (dir / "nothing.ply").string() + " " + scene + " -o " +
                               (dir / "r").string());
   EXPECT_EQ(model.status, 1);
