@@ -6,6 +6,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "core/paths.hpp"
 #include "eval/lpips.hpp"
@@ -132,7 +133,7 @@ void add_eval_command(CLI::App& app) {
       ->check(CLI::IsMember({"train", "test"}))
       ->capture_default_str();
   command->add_option("--downscale", args->downscale, "Ground-truth scene resolution 1/k")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--background", args->background, "Background for RGBA renders and ground truth")

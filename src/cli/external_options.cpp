@@ -1,5 +1,7 @@
 #include "cli/external_options.hpp"
 
+#include "cli/validators.hpp"
+
 namespace iesrgs::cli {
 
 void add_external_options(CLI::App& command, pipeline::ExternalOptions& o) {
@@ -7,7 +9,8 @@ void add_external_options(CLI::App& command, pipeline::ExternalOptions& o) {
       ->capture_default_str();
   command.add_option("--sr-weights", o.sr_weights, "SR checkpoint (default: the model's own)");
   command.add_option("--tile", o.tiles.tile, "SR tile side in input pixels, 0 = whole image")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kNonNegative);
   command
       .add_option("--depth-model", o.depth_model,
                   "none, or depth-anything-v2[-vits|-vitb|-vitl] (needs --depth-weights)")

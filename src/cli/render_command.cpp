@@ -7,6 +7,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "gs/model.hpp"
 #include "io/atomic_file.hpp"
@@ -78,7 +79,7 @@ void add_render_command(CLI::App& app) {
       ->check(CLI::IsMember({"train", "test"}))
       ->capture_default_str();
   command->add_option("--scale", args->scale, "Resolution factor over the cameras' (SR-splatting)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--path", args->path,
@@ -88,7 +89,7 @@ void add_render_command(CLI::App& app) {
                    "training cameras in order")
       ->check(CLI::IsMember({"orbit", "interp"}));
   command->add_option("--frames", args->frames, "Frames of --path")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--rasterize-mode", args->rasterize_mode,

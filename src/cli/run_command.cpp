@@ -6,6 +6,7 @@
 #include "cli/commands.hpp"
 #include "cli/external_options.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/validators.hpp"
 #include "pipeline/ie_srgs.hpp"
 #include "train/config.hpp"
 
@@ -58,11 +59,14 @@ void add_training_options(CLI::App& command, TrainingArgs& args, const std::stri
   const std::string prefix = stage.empty() ? "--" : "--" + stage + "-";
   command.add_option(prefix + "preset", args.preset, what + " schedule: paper, cpu, fast")
       ->capture_default_str();
-  command.add_option(prefix + "iterations", args.iterations,
-                     what + " iterations; the preset's schedule is rescaled to fit");
+  command
+      .add_option(prefix + "iterations", args.iterations,
+                  what + " iterations; the preset's schedule is rescaled to fit")
+      ->check(kPositive);
   command
       .add_option(prefix + "mv", args.views_per_iteration,
                   what + " views per iteration (multi-view regulation K)")
+      ->check(kPositive)
       ->capture_default_str();
   command.add_option(prefix + "set", args.assignments,
                      what + " training parameter key=value (repeatable; see config.json)");
@@ -87,13 +91,18 @@ CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
                    "IE-SRGS texture guidance: masked, average, external or internal")
       ->capture_default_str();
   command->add_option("--li", o.weights.internal_depth, "Internal depth weight (0 = off)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kNonNegative);
   command->add_option("--le", o.weights.external_depth, "External depth weight (0 = off)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kNonNegative);
   command->add_option("--dssim", o.weights.dssim_weight, "D-SSIM weight l of the texture loss")
-      ->capture_default_str();
-  command->add_option("--threshold", o.threshold,
-                      "Discrepancy threshold T (default 0.6 synthetic, 0.9 real scenes)");
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  command
+      ->add_option("--threshold", o.threshold,
+                   "Discrepancy threshold T (default 0.6 synthetic, 0.9 real scenes)")
+      ->check(kNonNegative);
   command->add_option("--init", o.init, "HR model start: scene (as 3DGS) or internal")
       ->check(CLI::IsMember({"scene", "internal"}))
       ->capture_default_str();
@@ -108,7 +117,8 @@ CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
   command
       ->add_option("--diagnostic-views", o.diagnostic_views,
                    "Training views in the diagnostics contact sheet")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kNonNegative);
   command->add_option("--seed", args->seed, "Random seed of both trainings")->capture_default_str();
   command->callback([args, only] { run_pipeline(*args, only); });
   return command;

@@ -1,5 +1,6 @@
 #include "cli/scene_options.hpp"
 
+#include "cli/validators.hpp"
 #include "core/error.hpp"
 
 namespace iesrgs::cli {
@@ -15,7 +16,7 @@ void SceneArgs::add_to(CLI::App& command) {
       .add_option("--downscale", options.downscale,
                   "Load images at 1/k resolution: <images>_<k>/ when present, else a "
                   "PIL-compatible bicubic resize")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       .add_option("--background", background,
@@ -24,7 +25,7 @@ void SceneArgs::add_to(CLI::App& command) {
   command
       .add_option("--test-every", options.test_every,
                   "Hold out every k-th image for test when the format has no test split")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
 }
 

@@ -7,6 +7,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "core/memory.hpp"
 #include "io/atomic_file.hpp"
@@ -114,10 +115,14 @@ void add_train_command(CLI::App& app) {
   command->add_option("-o,--output", args->output, "Output folder")->required();
   command->add_option("--preset", args->preset, "Schedule: paper (30k, GPU), cpu (10k), fast (3k)")
       ->capture_default_str();
-  command->add_option("--iterations", args->iterations,
-                      "Iterations; the preset's schedule is rescaled to fit");
-  command->add_option("--mv", args->views_per_iteration,
-                      "Views per iteration (multi-view regulation K; 1 = plain 3DGS)");
+  command
+      ->add_option("--iterations", args->iterations,
+                   "Iterations; the preset's schedule is rescaled to fit")
+      ->check(kPositive);
+  command
+      ->add_option("--mv", args->views_per_iteration,
+                   "Views per iteration (multi-view regulation K; 1 = plain 3DGS)")
+      ->check(kPositive);
   command->add_option("--seed", args->seed, "Random seed");
   command->add_option("--config", args->config_file, "JSON file of training parameters");
   command->add_option("--set", args->assignments,

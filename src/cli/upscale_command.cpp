@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "core/paths.hpp"
 #include "io/image.hpp"
@@ -103,12 +104,12 @@ void add_upscale_command(CLI::App& app) {
       ->add_option("--tile", args->tiles.tile,
                    "Tile side in input pixels, 0 for the whole image at once")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   command
       ->add_option("--tile-overlap", args->tiles.overlap,
                    "Input pixels shared by neighbouring tiles, cross-faded")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   command
       ->add_option("--background", args->background,
                    "Gray level in [0, 1] that transparent pixels are composited over")

@@ -115,6 +115,11 @@ TEST(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_EQ(rows.status, 1);
   EXPECT_TRUE(contains(last_line(rows.output), "unknown row 'best'")) << rows.output;
 
+  const CliRun threshold = iesrgs("run " + scene + " -o " + out + " --threshold -0.5");
+  EXPECT_NE(threshold.status, 0);
+  EXPECT_TRUE(contains(threshold.output, "--threshold: must be at least 0, got -0.5"))
+      << threshold.output;
+
   const CliRun internal = iesrgs("internal " + scene + " -o " + out + kTinySchedule);
   ASSERT_EQ(internal.status, 0) << internal.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "run" / "internal/sr/rgb/r_0.png"));

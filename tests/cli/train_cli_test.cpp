@@ -145,6 +145,10 @@ TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {
   const CliRun resume = iesrgs("train " + scene + " -o " + (dir / "b").string() + " --resume");
   EXPECT_EQ(resume.status, 1);
   EXPECT_TRUE(contains(last_line(resume.output), "config.json: missing")) << resume.output;
+  // Out-of-range numbers are refused before any work, in words.
+  const CliRun none = iesrgs("train " + scene + " -o " + (dir / "c").string() + " --iterations 0");
+  EXPECT_NE(none.status, 0);
+  EXPECT_TRUE(contains(none.output, "--iterations: must be greater than 0, got 0")) << none.output;
   const CliRun huge = iesrgs("train " + scene + " -o " + (dir / "c").string() +
                              " --set init=random --set random_points=2000000000");
   EXPECT_EQ(huge.status, 1);

@@ -1,0 +1,27 @@
+#pragma once
+// Checks of numeric options whose messages say what a value must be. CLI11's PositiveNumber and
+// NonNegativeNumber are ranges up to the largest double, which their messages print in full.
+#include <fmt/core.h>
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace iesrgs::cli {
+
+// A number greater than `bound`, or at least `bound` when `inclusive`.
+inline CLI::Validator number_above(double bound, bool inclusive, const std::string& name) {
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value)) return "must be a number, got " + text;
+        if (inclusive ? value >= bound : value > bound) return {};
+        return fmt::format("must be {} {}, got {}", inclusive ? "at least" : "greater than", bound,
+                           text);
+      },
+      name);
+}
+
+inline const CLI::Validator kPositive = number_above(0, false, "POSITIVE");
+inline const CLI::Validator kNonNegative = number_above(0, true, "NONNEGATIVE");
+
+}  // namespace iesrgs::cli
