@@ -1,13 +1,15 @@
-// iesrgs info: what a scene holds, and with --load-images whether every image decodes; or what
-// a trained model (.ply) holds.
+// iesrgs info: what a scene holds, and with --load-images whether every image decodes; what
+// a trained model (.ply) holds; or what a run folder of iesrgs run scored.
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
+#include "io/atomic_file.hpp"
 #include "io/model_file.hpp"
 #include "io/scene.hpp"
 #include "io/view_images.hpp"
@@ -71,6 +73,23 @@ void print_model_summary(const std::filesystem::path& path) {
   fmt::print("scale       median largest axis {:.4g}\n", median(largest_scale));
 }
 
+// A run folder of iesrgs run: its results table (once the run has finished) and each trained
+// row's model.
+void print_run_summary(const std::filesystem::path& run) {
+  const std::filesystem::path table = run / "results.md";
+  if (std::filesystem::exists(table))
+    fmt::print("{}", read_file(table));  // ends in a newline
+  else
+    fmt::print("no results.md yet: the run has not finished\n");
+  std::vector<std::filesystem::path> models;
+  for (const auto& row : std::filesystem::directory_iterator(run / "rows"))
+    if (std::filesystem::exists(row.path() / "point_cloud.ply"))
+      models.push_back(row.path() / "point_cloud.ply");
+  std::sort(models.begin(), models.end());
+  for (const std::filesystem::path& model : models)
+    fmt::print("model of {:<16} {}\n", model.parent_path().filename().string(), model.string());
+}
+
 // Decodes every image in order and stops at the first bad one (the Error names it).
 void load_every_image(const Scene& scene) {
   ViewImageOptions options;
@@ -92,8 +111,9 @@ void load_every_image(const Scene& scene) {
 void add_info_command(CLI::App& app) {
   auto* command =
       app.add_subcommand("info",
-                         "Print a scene's cameras, image size, splits, points and extent, or a "
-                         "trained model's (training folder, .ply, .spz, .splat) Gaussians");
+                         "Print a scene's cameras, image size, splits, points and extent, a "
+                         "trained model's (training folder, .ply, .spz, .splat) Gaussians, or a "
+                         "run folder's results");
   auto args = std::make_shared<SceneArgs>();
   auto load_images = std::make_shared<bool>(false);
   args->add_to(*command);
@@ -106,6 +126,10 @@ void add_info_command(CLI::App& app) {
         !is_scene(path) && std::filesystem::exists(path / "point_cloud.ply");
     if (is_model_file(path) || training_folder) {
       print_model_summary(model_file(path));
+      return;
+    }
+    if (!is_scene(path) && std::filesystem::is_directory(path / "rows")) {
+      print_run_summary(path);
       return;
     }
     const Scene scene = load_scene(args->path, args->resolved());

@@ -64,6 +64,11 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
   EXPECT_EQ(render.width, 48);
   EXPECT_EQ(read_image_header(dir / "run" / "internal/sr/rgb/r_0.png").width, 48);
 
+  const CliRun info = iesrgs("info " + out);
+  ASSERT_EQ(info.status, 0) << info.output;
+  EXPECT_TRUE(contains(info.output, "| IE-SRGS (+ mask) |")) << info.output;
+  EXPECT_TRUE(contains(info.output, "rows/hr/point_cloud.ply")) << info.output;
+
   const CliRun second = iesrgs(command);
   ASSERT_EQ(second.status, 0) << second.output;
   EXPECT_TRUE(contains(second.output, "reusing the finished model")) << second.output;
