@@ -58,14 +58,13 @@ train::TrainConfig resolve_config(const TrainArgs& args, const std::filesystem::
 }
 
 // The saved config is the run's identity: an option that would change it cannot take effect.
-void refuse_changes_on_resume(const CLI::App& command) {
-  for (const char* name :
-       {"--preset", "--iterations", "--mv", "--seed", "--config", "--set", "--init-ply"})
-    if (command.get_option(name)->count() > 0)
+void refuse_changes_on_resume(const std::vector<const CLI::Option*>& run_options) {
+  for (const CLI::Option* option : run_options)
+    if (option->count() > 0)
       fail(
           "{} cannot change a resumed run: --resume continues with the config saved in the output "
           "folder (train into a new folder for other settings)",
-          name);
+          option->get_name());
 }
 
 void run_train(const TrainArgs& args) {
@@ -83,9 +82,10 @@ void run_train(const TrainArgs& args) {
              setup.train_views.size(), width, height, setup.test_views.size(), config.preset,
              config.iterations, config.views_per_iteration);
 
-  train::Trainer trainer(config, std::move(setup),
-                         train::initial_model(scene, config, args.init_ply));
-  if (args.resume) trainer.resume();
+  train::Trainer trainer = args.resume
+                               ? train::Trainer::resumed(config, std::move(setup))
+                               : train::Trainer(config, std::move(setup),
+                                                train::initial_model(scene, config, args.init_ply));
   const train::TrainSummary summary = trainer.run();
   if (summary.interrupted) return;
   train::write_point_clouds(out, trainer.model());
@@ -113,25 +113,32 @@ void add_train_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand("train", "Train a Gaussian-splatting model on a scene");
   args->scene.add_to(*command);
   command->add_option("-o,--output", args->output, "Output folder")->required();
-  command->add_option("--preset", args->preset, "Schedule: paper (30k, GPU), cpu (10k), fast (3k)")
+  // The options that make up the run's config, which --resume takes from the output folder.
+  std::vector<const CLI::Option*> run_options;
+  const auto defines_run = [&run_options](CLI::Option* option) {
+    run_options.push_back(option);
+    return option;
+  };
+  defines_run(command->add_option("--preset", args->preset,
+                                  "Schedule: paper (30k, GPU), cpu (10k), fast (3k)"))
       ->capture_default_str();
-  command
-      ->add_option("--iterations", args->iterations,
-                   "Iterations; the preset's schedule is rescaled to fit")
+  defines_run(command->add_option("--iterations", args->iterations,
+                                  "Iterations; the preset's schedule is rescaled to fit"))
       ->check(kPositive);
-  command
-      ->add_option("--mv", args->views_per_iteration,
-                   "Views per iteration (multi-view regulation K; 1 = plain 3DGS)")
+  defines_run(command->add_option("--mv", args->views_per_iteration,
+                                  "Views per iteration (multi-view regulation K; 1 = plain 3DGS)"))
       ->check(kPositive);
-  command->add_option("--seed", args->seed, "Random seed");
-  command->add_option("--config", args->config_file, "JSON file of training parameters");
-  command->add_option("--set", args->assignments,
-                      "Override one training parameter, key=value (repeatable; see config.json)");
-  command->add_option("--init-ply", args->init_ply,
-                      "Start from this 3DGS .ply, .spz or .splat instead");
+  defines_run(command->add_option("--seed", args->seed, "Random seed"));
+  defines_run(
+      command->add_option("--config", args->config_file, "JSON file of training parameters"));
+  defines_run(command->add_option(
+      "--set", args->assignments,
+      "Override one training parameter, key=value (repeatable; see config.json)"));
+  defines_run(command->add_option("--init-ply", args->init_ply,
+                                  "Start from this 3DGS .ply, .spz or .splat instead"));
   command->add_flag("--resume", args->resume, "Continue the run in --output from its checkpoint");
-  command->callback([args, command] {
-    if (args->resume) refuse_changes_on_resume(*command);
+  command->callback([args, run_options] {
+    if (args->resume) refuse_changes_on_resume(run_options);
     run_train(*args);
   });
 }

@@ -57,17 +57,15 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
             stage_seconds(dir), true};
   }
   const bool resumable = stage_json(dir).value("params", nlohmann::json()) == identity &&
-                         fs::exists(dir / "checkpoint.pt");
+                         fs::exists(train::checkpoint_path(dir));
   if (!resumable) {  // an older run's checkpoint would be resumed by the next identical run
     fs::remove(dir / "train_log.csv");
-    fs::remove(dir / "checkpoint.pt");
+    fs::remove(train::checkpoint_path(dir));
   }
   record_stage(dir, identity, false, 0);
-  train::Trainer trainer(config, std::move(setup), initial_model());
-  if (resumable) {
-    fmt::print("{}: resuming from {}\n", name, trainer.checkpoint_path().string());
-    trainer.resume();
-  }
+  if (resumable) fmt::print("{}: resuming from {}\n", name, train::checkpoint_path(dir).string());
+  train::Trainer trainer = resumable ? train::Trainer::resumed(config, std::move(setup))
+                                     : train::Trainer(config, std::move(setup), initial_model());
   const train::TrainSummary summary = trainer.run();
   if (summary.interrupted)
     fail("{} interrupted at iteration {}; run the same command again to resume", name,

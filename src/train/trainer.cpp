@@ -99,10 +99,6 @@ Trainer::Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianMode
   stats_ = gs::DensifyStats::zeros(model_.size());
 }
 
-std::filesystem::path Trainer::checkpoint_path() const {
-  return setup_.output_dir / "checkpoint.pt";
-}
-
 void Trainer::save_checkpoint() {
   // Never replace a good checkpoint with a broken model.
   if (!all_finite(model_)) fail_diverged(iteration_, last_loss_);
@@ -124,7 +120,15 @@ void Trainer::save_checkpoint() {
   checkpoint_iteration_ = iteration_;
 }
 
-void Trainer::resume() {
+Trainer Trainer::resumed(const TrainConfig& config, TrainerSetup setup) {
+  // An empty model stands in until the checkpoint replaces the model, the optimizer and the
+  // densification statistics together.
+  Trainer trainer(config, std::move(setup), gs::model_from_points({}, {}));
+  trainer.load_checkpoint();
+  return trainer;
+}
+
+void Trainer::load_checkpoint() {
   const std::filesystem::path path = checkpoint_path();
   if (!std::filesystem::exists(path))
     fail_file(path, "no checkpoint to resume from (train without --resume first)");

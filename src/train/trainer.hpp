@@ -50,13 +50,18 @@ struct TrainSummary {
   int64_t gaussians = 0;
 };
 
+// Where a trainer writing to `output_dir` keeps its checkpoint.
+inline std::filesystem::path checkpoint_path(const std::filesystem::path& output_dir) {
+  return output_dir / "checkpoint.pt";
+}
+
 class Trainer {
  public:
   Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianModel initial);
 
-  // Continues from <output_dir>/checkpoint.pt exactly as if the run had never stopped. Throws
-  // Error naming the file when it is missing or unreadable.
-  void resume();
+  // Continues the run checkpointed in setup.output_dir exactly as if it had never stopped; no
+  // starting model is built. Throws Error naming the checkpoint when it is missing or unreadable.
+  static Trainer resumed(const TrainConfig& config, TrainerSetup setup);
 
   // Trains to config.iterations, printing progress; checkpoints every config.checkpoint_every
   // iterations and when SIGINT arrives (then returns with summary.interrupted). Throws Error when
@@ -64,12 +69,15 @@ class Trainer {
   TrainSummary run();
 
   const gs::GaussianModel& model() const { return model_; }
-  std::filesystem::path checkpoint_path() const;
+  std::filesystem::path checkpoint_path() const {
+    return train::checkpoint_path(setup_.output_dir);
+  }
 
   // Mean PSNR of the model on `views` (all of them).
   double evaluate_psnr(const std::vector<TrainView>& views) const;
 
  private:
+  void load_checkpoint();
   double step(int64_t iteration);  // one optimizer step; returns the loss
   std::vector<int> pick_views();
   void densify(int64_t iteration);

@@ -120,6 +120,7 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   const CliRun resumed = iesrgs(train + " --resume");
   ASSERT_EQ(resumed.status, 0) << resumed.output;
   EXPECT_TRUE(contains(resumed.output, "resuming")) << resumed.output;
+  EXPECT_FALSE(contains(resumed.output, "random points")) << resumed.output;  // the checkpoint's
   EXPECT_EQ(read_file(dir / "run" / "point_cloud.ply"), model);
   const auto again = nlohmann::json::parse(read_file(dir / "run" / "training.json"));
   for (const char* key : {"iterations", "gaussians", "final_loss", "test_psnr"})
@@ -131,6 +132,10 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   EXPECT_EQ(longer.status, 1);
   EXPECT_TRUE(contains(last_line(longer.output), "--iterations cannot change a resumed run"))
       << longer.output;
+  const CliRun reseeded = iesrgs(train + " --resume --seed 3");
+  EXPECT_EQ(reseeded.status, 1);
+  EXPECT_TRUE(contains(last_line(reseeded.output), "--seed cannot change a resumed run"))
+      << reseeded.output;
 }
 
 TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {

@@ -122,8 +122,7 @@ TEST_F(TrainerTest, InterruptedRunResumesToTheSameModel) {
   ASSERT_TRUE(partial.interrupted);
   EXPECT_EQ(partial.iterations, 17);
 
-  Trainer second(config(), s, initial());
-  second.resume();
+  Trainer second = Trainer::resumed(config(), s);
   const auto start = std::chrono::steady_clock::now();
   const TrainSummary resumed = second.run();
   const std::chrono::duration<double> second_run = std::chrono::steady_clock::now() - start;
@@ -175,8 +174,9 @@ TEST_F(TrainerTest, NonFiniteParametersStopAtTheNextCheckpoint) {
 
 TEST_F(TrainerTest, ResumeWithoutCheckpointIsAClearError) {
   TempDir out;
-  Trainer trainer(config(), setup(out.path()), initial());
-  EXPECT_NE(error_message([&] { trainer.resume(); }).find("no checkpoint"), std::string::npos);
+  EXPECT_NE(
+      error_message([&] { Trainer::resumed(config(), setup(out.path())); }).find("no checkpoint"),
+      std::string::npos);
 }
 
 TEST_F(TrainerTest, PointCloudsRoundTripThroughPly) {
