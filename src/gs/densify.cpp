@@ -86,6 +86,16 @@ Tensor mean_gradient(const DensifyStats& stats, GradientSource source) {
   return torch::where(stats.count > 0, sum / stats.count.clamp_min(1), torch::zeros_like(sum));
 }
 
+// `selected` narrowed to its `budget` Gaussians of the largest gradient when it holds more.
+Tensor within_budget(const Tensor& selected, const Tensor& gradient, int64_t budget) {
+  const Tensor candidates = selected.nonzero().squeeze(1);
+  if (candidates.size(0) <= budget) return selected;
+  const Tensor best = std::get<1>(gradient.index({candidates}).topk(budget));
+  Tensor kept = torch::zeros_like(selected);
+  kept.index_put_({candidates.index({best})}, true);
+  return kept;
+}
+
 Tensor prune_mask(const GaussianModel& model, const DensifyStats& stats,
                   const DensifyOptions& options, double scene_extent) {
   Tensor mask = torch::sigmoid(model.opacity_logits.detach()) < options.min_opacity;
@@ -141,10 +151,18 @@ DensifyCounts densify_and_prune(GaussianModel& model, GaussianOptimizer& optimiz
                                 double scene_extent) {
   torch::NoGradGuard no_grad;
   const int64_t n = model.size();
-  const Tensor selected = mean_gradient(stats, options.source) >= options.grad_threshold;
+  const Tensor gradient = mean_gradient(stats, options.source);
+  Tensor selected = gradient >= options.grad_threshold;
+  DensifyCounts counts;
+  if (options.max_gaussians > 0) {  // each clone and each split adds one Gaussian
+    const int64_t wanted = selected.sum().item<int64_t>();
+    selected = within_budget(selected, gradient, std::max<int64_t>(0, options.max_gaussians - n));
+    counts.held_back = wanted - selected.sum().item<int64_t>();
+  }
   const Tensor large = max_scale(model) > options.percent_dense * scene_extent;
   const Tensor clone = selected & ~large, split = selected & large;
-  DensifyCounts counts{clone.sum().item<int64_t>(), split.sum().item<int64_t>(), 0};
+  counts.cloned = clone.sum().item<int64_t>();
+  counts.split = split.sum().item<int64_t>();
 
   // Rows as 3DGS orders them: originals, their clones, then the split children; split parents go.
   const NewRows clones = copies_of(model, clone);

@@ -29,6 +29,9 @@ struct DensifyOptions {
   double min_opacity = 0.005;
   float max_screen_size = 0;  // prune splats drawn larger (max radius, pixels); 0: off
   double max_world_size = 0;  // prune splats larger than this x the extent; 0: off
+  // Clones and splits stop at this many Gaussians, those of the largest gradients going first;
+  // 0: no cap.
+  int64_t max_gaussians = 0;
 };
 
 // Per-Gaussian accumulators between two densification steps, as 3DGS's xyz_gradient_accum,
@@ -48,6 +51,7 @@ struct DensifyStats {
 
 struct DensifyCounts {
   int64_t cloned = 0, split = 0, pruned = 0;
+  int64_t held_back = 0;  // selected, but neither cloned nor split because of max_gaussians
 };
 
 // Clones small Gaussians and splits large ones whose mean gradient reaches the threshold, then

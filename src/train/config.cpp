@@ -33,6 +33,7 @@ void visit_fields(Config& c, Visit&& visit) {
   visit("max_screen_size", c.max_screen_size);
   visit("max_world_size", c.max_world_size);
   visit("filter_update_every", c.filter_update_every);
+  visit("max_gaussians", c.max_gaussians);
   visit("lr_position_initial", c.learning_rates.position_initial);
   visit("lr_position_final", c.learning_rates.position_final);
   visit("lr_position_max_steps", c.learning_rates.position_max_steps);
@@ -152,6 +153,7 @@ void validate(const TrainConfig& c) {
   require(c.checkpoint_every >= 0 && c.test_every >= 0 && c.test_views >= 0,
           "checkpoint_every, test_every and test_views must not be negative");
   require(c.grad_threshold > 0, "grad_threshold must be positive");
+  require(c.max_gaussians >= 0, "max_gaussians must be 0 (no cap) or positive");
   require(c.init == "auto" || c.init == "random", "init must be \"auto\" or \"random\"");
   require(c.random_points > 0 && c.random_extent > 0, "random init needs points and extent");
   require(c.learning_rates.position_max_steps > 0, "lr_position_max_steps must be positive");

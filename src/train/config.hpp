@@ -34,6 +34,9 @@ struct TrainConfig {
   float max_screen_size = 0;          // pixels
   double max_world_size = 0.1;        // x the scene extent
   int64_t filter_update_every = 100;  // Mip-Splatting 3D filter, once densification has stopped
+  // Densification grows the model no further than this (largest gradients first); 0: no cap
+  // but the available memory.
+  int64_t max_gaussians = 0;
 
   gs::LearningRates learning_rates;
 

@@ -1,6 +1,7 @@
 #include "train/trainer.hpp"
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <csignal>
 #include <fstream>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -74,13 +76,14 @@ bool all_finite(const gs::GaussianModel& model) {
   return true;
 }
 
+// Parameters, gradients, Adam moments, densification statistics and the per-view projection
+// buffers: the peak resident memory grows by about 1.4 KB per Gaussian (measured from 0.1M to 3M
+// random points).
+constexpr int64_t kBytesPerGaussian = 1400;
+
 }  // namespace
 
 void require_training_memory(int64_t gaussians) {
-  // Parameters, gradients, Adam moments, densification statistics and the per-view projection
-  // buffers: the peak resident memory grows by about 1.4 KB per Gaussian (measured from 0.1M to
-  // 3M random points).
-  constexpr int64_t kBytesPerGaussian = 1400;
   require_memory(gaussians * kBytesPerGaussian, fmt::format("training {} Gaussians", gaussians));
 }
 
@@ -208,7 +211,17 @@ void Trainer::densify(int64_t iteration) {
       const bool after_reset = iteration > c.opacity_reset_every;
       options.max_screen_size = after_reset ? c.max_screen_size : 0;
       options.max_world_size = after_reset ? c.max_world_size : 0;
-      gs::densify_and_prune(model_, *optimizer_, stats_, options, setup_.scene_extent);
+      options.max_gaussians = densify_cap();
+      const gs::DensifyCounts counts =
+          gs::densify_and_prune(model_, *optimizer_, stats_, options, setup_.scene_extent);
+      const bool below_config = c.max_gaussians == 0 || options.max_gaussians < c.max_gaussians;
+      if (counts.held_back > 0 && below_config && !memory_capped_) {
+        memory_capped_ = true;
+        spdlog::warn(
+            "iteration {}: densification stops at {} Gaussians, as many as the available memory "
+            "holds ({} more were due to clone or split)",
+            iteration, options.max_gaussians, counts.held_back);
+      }
       gs::update_filter_3d(model_, train_cameras_);
     }
     const bool white = setup_.background == std::array<float, 3>{1, 1, 1};
@@ -218,6 +231,15 @@ void Trainer::densify(int64_t iteration) {
     // As Mip-Splatting: keep the filter current, but not in the last steps.
     gs::update_filter_3d(model_, train_cameras_);
   }
+}
+
+int64_t Trainer::densify_cap() const {
+  // Linux overcommits: growing past the available memory would get the process killed later.
+  const int64_t available = available_memory_bytes();
+  const int64_t configured =
+      config_.max_gaussians > 0 ? config_.max_gaussians : std::numeric_limits<int64_t>::max();
+  if (available < 0) return configured;
+  return std::min(configured, model_.size() + available / kBytesPerGaussian);
 }
 
 void Trainer::fail_diverged(int64_t iteration, double loss) const {

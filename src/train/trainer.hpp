@@ -81,6 +81,7 @@ class Trainer {
   double step(int64_t iteration);  // one optimizer step; returns the loss
   std::vector<int> pick_views();
   void densify(int64_t iteration);
+  int64_t densify_cap() const;  // config.max_gaussians, or fewer when memory runs short
   void save_checkpoint();
   [[noreturn]] void fail_diverged(int64_t iteration, double loss) const;
   double report_test_psnr();
@@ -100,6 +101,7 @@ class Trainer {
   // them rather than zeros.
   double last_loss_ = 0;
   double last_test_psnr_ = 0;
+  bool memory_capped_ = false;  // densification was held back for memory (warned once)
   std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now();
 };
 

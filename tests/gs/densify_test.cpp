@@ -160,6 +160,30 @@ TEST(Densify, AbsoluteGradientsCanDriveDensification) {
   EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).cloned, 1);
 }
 
+// Under max_gaussians the Gaussians of the largest gradient grow first, and the rest wait.
+TEST(Densify, MaxGaussiansGrowsTheLargestGradientsFirst) {
+  // 0 and 2 small (clones), 1 large (split); gradients 3e-4, 5e-4, 4e-4, all over the threshold.
+  GaussianModel m = tiny_model({0.05f, 0.5f, 0.05f}, {0.5f, 0.5f, 0.5f});
+  GaussianOptimizer opt(m, {}, kExtent);
+  DensifyStats stats = DensifyStats::zeros(3);
+  stats.accumulate({view({3e-4f, 5e-4f, 4e-4f}, {1, 1, 1})});
+  DensifyOptions options;
+  options.max_gaussians = 5;
+  const DensifyCounts counts = densify_and_prune(m, opt, stats, options, kExtent);
+  EXPECT_EQ(counts.split, 1);
+  EXPECT_EQ(counts.cloned, 1);
+  EXPECT_EQ(counts.held_back, 1);
+  ASSERT_EQ(m.size(), 5);
+  // Rows: originals 0 and 2, the clone of 2, the two children of 1.
+  EXPECT_TRUE(torch::equal(m.means.select(1, 0).narrow(0, 0, 3), torch::tensor({0.f, 2.f, 2.f})));
+
+  stats.accumulate({view(std::vector<float>(5, 1.f), std::vector<int>(5, 1))});
+  const DensifyCounts full = densify_and_prune(m, opt, stats, options, kExtent);
+  EXPECT_EQ(full.cloned + full.split, 0);
+  EXPECT_EQ(full.held_back, 5);
+  EXPECT_EQ(m.size(), 5);
+}
+
 TEST(Densify, PrunesOversizedGaussiansOnlyWhenEnabled) {
   // 0: fine; 1: 30 px on screen; 2: world scale 2 > 0.1 * extent (and large, low gradient).
   GaussianModel m = tiny_model({0.05f, 0.05f, 2.f}, {0.5f, 0.5f, 0.5f});

@@ -98,6 +98,16 @@ TEST_F(TrainerTest, FittingRaisesTestPsnrAndDensifies) {
   EXPECT_TRUE(std::filesystem::exists(out / "train_log.csv"));
 }
 
+TEST_F(TrainerTest, MaxGaussiansCapsTheGrowth) {
+  TempDir free_dir, capped_dir;
+  Trainer free(config(), setup(free_dir.path()), initial());
+  ASSERT_GT(free.run().gaussians, 2000);  // the cap below binds
+  TrainConfig c = config();
+  c.max_gaussians = 2000;
+  Trainer capped(c, setup(capped_dir.path()), initial());
+  EXPECT_LE(capped.run().gaussians, 2000);
+}
+
 TEST_F(TrainerTest, InterruptedRunResumesToTheSameModel) {
   TempDir straight_dir, resumed_dir;
   Trainer straight(config(), setup(straight_dir.path()), initial());
