@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "core/error.hpp"
+#include "cli/validators.hpp"
 #include "core/math.hpp"
 #include "gs/benchmark_model.hpp"
 #include "gs/optimizer.hpp"
@@ -59,9 +59,7 @@ struct Timing {
   double cpu_ms = 0;   // mean, summed over threads
 };
 
-void apply(const RepeatArgs& repeat, const char* command) {
-  if (repeat.iterations <= 0 || repeat.threads < 0)
-    fail("bench {}: --iterations must be positive and --threads not negative", command);
+void apply(const RepeatArgs& repeat) {
   // Through LibTorch, whose first operation on a thread would otherwise set OpenMP's thread
   // count back to its own.
   if (repeat.threads > 0) torch::set_num_threads(repeat.threads);
@@ -85,9 +83,7 @@ Timing time_runs(int iterations, const std::function<void(int)>& work) {
 }
 
 void run_raster_bench(const RasterBenchArgs& args) {
-  if (args.gaussians < 0 || args.width <= 0 || args.height <= 0)
-    fail("bench raster: --width and --height must be positive, --gaussians not negative");
-  apply(args.repeat, "raster");
+  apply(args.repeat);
   using namespace raster;
   const RasterCamera<float> cam = benchmark_camera(args.width, args.height);
   const GaussianCloud cloud = synthetic_scene(args.gaussians, cam, 1);
@@ -136,9 +132,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
 }
 
 void run_ssim_bench(const SsimBenchArgs& args) {
-  if (args.width <= 0 || args.height <= 0)
-    fail("bench ssim: --width and --height must be positive");
-  apply(args.repeat, "ssim");
+  apply(args.repeat);
   const loss::ImageShape shape{args.height, args.width, 3};
   const std::vector<float> x = loss::benchmark_image(shape, 1), y = loss::benchmark_image(shape, 2);
   std::vector<float> partials(loss::ssim_partials_size(shape)), grad(shape.values());
@@ -161,8 +155,7 @@ void run_ssim_bench(const SsimBenchArgs& args) {
 }
 
 void run_adam_bench(const AdamBenchArgs& args) {
-  if (args.gaussians <= 0) fail("bench adam: --gaussians must be positive");
-  apply(args.repeat, "adam");
+  apply(args.repeat);
   const int64_t n = args.gaussians;
   gs::GaussianModel model = gs::benchmark_model(n);
   int64_t floats = 0;
@@ -179,13 +172,16 @@ void run_adam_bench(const AdamBenchArgs& args) {
 }
 
 void add_repeat_options(CLI::App* command, RepeatArgs& repeat) {
-  command->add_option("--threads", repeat.threads, "OpenMP threads (default: all cores)");
-  command->add_option("--iterations", repeat.iterations, "Timed iterations")->capture_default_str();
+  command->add_option("--threads", repeat.threads, "OpenMP threads (default: all cores)")
+      ->check(kNonNegative);
+  command->add_option("--iterations", repeat.iterations, "Timed iterations")
+      ->capture_default_str()
+      ->check(kPositive);
 }
 
 void add_image_size(CLI::App* command, int& width, int& height) {
-  command->add_option("--width", width, "Image width")->capture_default_str();
-  command->add_option("--height", height, "Image height")->capture_default_str();
+  command->add_option("--width", width, "Image width")->capture_default_str()->check(kPositive);
+  command->add_option("--height", height, "Image height")->capture_default_str()->check(kPositive);
 }
 
 }  // namespace
@@ -197,7 +193,8 @@ void add_bench_command(CLI::App& app) {
   auto* raster = bench->add_subcommand("raster", "Time the CPU rasterizer, forward and backward");
   auto raster_args = std::make_shared<RasterBenchArgs>();
   raster->add_option("--gaussians", raster_args->gaussians, "Number of Gaussians")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kNonNegative);
   add_image_size(raster, raster_args->width, raster_args->height);
   add_repeat_options(raster, raster_args->repeat);
   raster->callback([raster_args] { run_raster_bench(*raster_args); });
@@ -211,7 +208,8 @@ void add_bench_command(CLI::App& app) {
   auto* adam = bench->add_subcommand("adam", "Time the optimizer step over every parameter");
   auto adam_args = std::make_shared<AdamBenchArgs>();
   adam->add_option("--gaussians", adam_args->gaussians, "Number of Gaussians")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kPositive);
   add_repeat_options(adam, adam_args->repeat);
   adam->callback([adam_args] { run_adam_bench(*adam_args); });
 }

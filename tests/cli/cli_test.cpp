@@ -83,10 +83,15 @@ TEST(Cli, BenchModesPrintTheirTimings) {
 }
 
 TEST(Cli, BenchRefusesEmptyWork) {
-  EXPECT_EQ(last_line(iesrgs("bench ssim --width 0").output),
-            "error: bench ssim: --width and --height must be positive");
-  EXPECT_EQ(last_line(iesrgs("bench adam --iterations 0").output),
-            "error: bench adam: --iterations must be positive and --threads not negative");
+  const CliRun narrow = iesrgs("bench ssim --width 0");
+  EXPECT_EQ(narrow.status, 105);
+  EXPECT_TRUE(contains(narrow.output, "--width: must be greater than 0, got 0")) << narrow.output;
+  const CliRun none = iesrgs("bench adam --iterations 0");
+  EXPECT_EQ(none.status, 105);
+  EXPECT_TRUE(contains(none.output, "--iterations: must be greater than 0, got 0")) << none.output;
+  const CliRun threads = iesrgs("bench raster --threads -1");
+  EXPECT_EQ(threads.status, 105);
+  EXPECT_TRUE(contains(threads.output, "--threads: must be at least 0, got -1")) << threads.output;
 }
 
 TEST(Cli, UpscaleWritesOnePngPerImageOfAFolder) {
