@@ -81,9 +81,12 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
         options.depth_model == "none" ? fs::path() : dir / "depth" / (camera.name + ".npy")};
     views.push_back(view);
     const std::string fingerprint = view_fingerprint(stage, images, camera);
-    const bool cached = record.value(camera.name, "") == fingerprint && fs::exists(view.image) &&
-                        (view.depth.empty() || fs::exists(view.depth));
-    if (cached) continue;
+    if (record.value(camera.name, "") == fingerprint) {
+      const Intrinsics upscaled = camera.intrinsics.scaled(options.scale);
+      if (cached_view_intact(view.image, view.depth, upscaled.width, upscaled.height)) continue;
+      fmt::print("external {}: the cached output is damaged or missing; computing it again\n",
+                 camera.name);
+    }
     if (!loaded) {
       sr = priors::sr::make_sr_net(options.sr_model, options.sr_weights, options.scale);
       depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights);

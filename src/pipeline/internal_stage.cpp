@@ -23,13 +23,16 @@ nlohmann::json sr_params(double model_seconds, int scale) {
   return {{"model_seconds", model_seconds}, {"scale", scale}};
 }
 
-// Whether SR-splatting's renders of every training view are there: one deleted (say, because it
-// was damaged) renders them again.
-bool renders_present(const std::filesystem::path& sr_dir, const Scene& lr_scene) {
-  for (const Camera* camera : lr_scene.split(Split::Train))
-    if (!std::filesystem::exists(sr_dir / "rgb" / (camera->name + ".png")) ||
-        !std::filesystem::exists(sr_dir / "depth" / (camera->name + ".npy")))
+// Whether SR-splatting's renders of every training view are there and intact: one deleted or
+// damaged renders them again.
+bool renders_present(const std::filesystem::path& sr_dir, const Scene& lr_scene, int scale) {
+  for (const Camera* camera : lr_scene.split(Split::Train)) {
+    const Intrinsics rendered = camera->intrinsics.scaled(scale);
+    if (!cached_view_intact(sr_dir / "rgb" / (camera->name + ".png"),
+                            sr_dir / "depth" / (camera->name + ".npy"), rendered.width,
+                            rendered.height))
       return false;
+  }
   return true;
 }
 
@@ -55,7 +58,7 @@ InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train
       dir / "sr"};
   const nlohmann::json sr = sr_params(stage.training.seconds, scale);
   if (stage.training.cached && stage_finished(stage.sr_dir, sr) &&
-      renders_present(stage.sr_dir, lr_scene))
+      renders_present(stage.sr_dir, lr_scene, scale))
     return stage;
   fmt::print("SR-splatting: rendering {} training views at x{}\n", cameras.size(), scale);
   const auto start = std::chrono::steady_clock::now();
@@ -71,7 +74,7 @@ bool internal_stage_current(const Scene& lr_scene, const std::string& train_dige
                             const std::filesystem::path& dir) {
   return training_stage_current(dir, internal_params(lr_scene, train_digest), config) &&
          stage_finished(dir / "sr", sr_params(stage_seconds(dir), scale)) &&
-         renders_present(dir / "sr", lr_scene);
+         renders_present(dir / "sr", lr_scene, scale);
 }
 
 }  // namespace iesrgs::pipeline

@@ -5,6 +5,8 @@
 
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
+#include "io/image.hpp"
+#include "io/npy.hpp"
 
 namespace iesrgs::pipeline {
 
@@ -12,6 +14,18 @@ nlohmann::json read_stage_record(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) return nlohmann::json::object();
   nlohmann::json record = nlohmann::json::parse(read_file(path), nullptr, false);
   return record.is_object() ? record : nlohmann::json::object();
+}
+
+bool cached_view_intact(const std::filesystem::path& image, const std::filesystem::path& depth,
+                        int width, int height) {
+  try {
+    const Image8 decoded = read_image8(image);
+    if (decoded.width != width || decoded.height != height) return false;
+    return depth.empty() ||
+           read_npy(depth).shape == std::vector<size_t>{size_t(height), size_t(width)};
+  } catch (const Error&) {
+    return false;
+  }
 }
 
 std::string split_digest(const ViewImages& images, Split split) {

@@ -28,6 +28,12 @@ auto read_cached_output(const std::filesystem::path& path, Read read) -> decltyp
   }
 }
 
+// Whether a cached view's image (and depth map, unless `depth` is empty) decode at width x height.
+// Files damaged or replaced since they were written are made again rather than failing a later
+// stage.
+bool cached_view_intact(const std::filesystem::path& image, const std::filesystem::path& depth,
+                        int width, int height);
+
 // One digest of the cameras of a split of `images`' scene (name, pinhole, distortion, pose), of
 // the content of the image files `images` reads for them and of the background they are
 // composited over, for the records of the stages that learn from or are scored against them. Not

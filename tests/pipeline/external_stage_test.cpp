@@ -51,6 +51,14 @@ TEST(ExternalStage, SuperResolvesEveryTrainingViewOnceAndRecomputesOnChange) {
   EXPECT_NE(std::filesystem::last_write_time(views[0].image), written);
   EXPECT_EQ(std::filesystem::last_write_time(views[1].image), written_second);
 
+  // A damaged cached file, or one replaced by an image of another size, is computed again.
+  const std::string good = read_file(views[1].image);
+  write_file_atomically(views[1].image, good.substr(0, good.size() / 2));
+  write_png(views[2].image, Image8(5, 5, 3));
+  run_external_stage(scene, images, options, dir / "ext");
+  EXPECT_EQ(read_file(views[1].image), good);
+  EXPECT_EQ(read_image_header(views[2].image).width, 32);
+
   options.scale = 4;  // a different stage: every view again
   run_external_stage(scene, images, options, dir / "ext");
   EXPECT_EQ(read_image_header(views[0].image).width, 64);

@@ -4,6 +4,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
+#include "io/npy.hpp"
 #include "support/temp_dir.hpp"
 #include "synth/dataset_writer.hpp"
 
@@ -15,6 +16,22 @@ using testing::TempDir;
 // Digests are taken once per ViewImages (one run), so each check reads the files afresh.
 std::string train_digest(const Scene& scene) {
   return split_digest(ViewImages(scene), Split::Train);
+}
+
+TEST(StageRecord, CachedViewIsIntactOnlyWhenItDecodesAtItsSize) {
+  TempDir dir;
+  const auto image = dir / "v.png", depth = dir / "v.npy";
+  write_png(image, Image8(6, 4, 3));
+  write_npy(depth, std::vector<float>(24, 1.f), {4, 6});
+  EXPECT_TRUE(cached_view_intact(image, depth, 6, 4));
+  EXPECT_TRUE(cached_view_intact(image, {}, 6, 4));  // no depth map to check
+  EXPECT_FALSE(cached_view_intact(image, depth, 12, 8));
+  EXPECT_FALSE(cached_view_intact(dir / "missing.png", {}, 6, 4));
+  write_npy(depth, std::vector<float>(24, 1.f), {6, 4});
+  EXPECT_FALSE(cached_view_intact(image, depth, 6, 4));
+  const std::string bytes = read_file(image);
+  write_file_atomically(image, bytes.substr(0, bytes.size() - 8));
+  EXPECT_FALSE(cached_view_intact(image, {}, 6, 4));
 }
 
 TEST(StageRecord, SplitDigestFollowsCamerasImageContentAndBackground) {
