@@ -6,7 +6,7 @@
 
 namespace iesrgs {
 
-void write_cameras_json(const std::filesystem::path& path, const std::vector<Camera>& cameras) {
+std::string cameras_json(const std::vector<Camera>& cameras) {
   nlohmann::json entries = nlohmann::json::array();
   for (size_t id = 0; id < cameras.size(); ++id) {
     const Camera& camera = cameras[id];
@@ -25,7 +25,11 @@ void write_cameras_json(const std::filesystem::path& path, const std::vector<Cam
                        {"fy", camera.intrinsics.fy},
                        {"fx", camera.intrinsics.fx}});
   }
-  write_file_atomically(path, entries.dump() + "\n");
+  return entries.dump() + "\n";
+}
+
+void write_cameras_json(const std::filesystem::path& path, const std::vector<Camera>& cameras) {
+  write_file_atomically(path, cameras_json(cameras));
 }
 
 }  // namespace iesrgs

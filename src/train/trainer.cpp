@@ -19,6 +19,7 @@
 #include "eval/metrics.hpp"
 #include "gs/checkpoint.hpp"
 #include "gs/densify.hpp"
+#include "io/atomic_file.hpp"
 #include "io/cameras_json.hpp"
 #include "loss/autograd.hpp"
 #include "raster/rasterizer.hpp"
@@ -138,6 +139,7 @@ void Trainer::load_checkpoint() {
   gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}},
                               {"seconds", {}},   {"loss", {}},     {"test_psnr", {}}};
   gs::load_training_state(path, model_, *optimizer_, stats_, &extras);
+  require_same_cameras();
   for (const char* required : {"iteration", "view_rng", "torch_rng"})
     if (!extras[required].defined())
       fail_file(path, fmt::format("not a training checkpoint of iesrgs train (no {})", required));
@@ -156,6 +158,16 @@ void Trainer::load_checkpoint() {
   std::lock_guard<std::mutex> lock(generator.mutex());
   generator.set_state(extras["torch_rng"]);
   checkpoint_iteration_ = iteration_;
+}
+
+void Trainer::require_same_cameras() const {
+  // Resuming on other views (another --downscale, another scene) would go on training the model
+  // on images it did not start from.
+  const std::filesystem::path saved = setup_.output_dir / "cameras.json";
+  if (std::filesystem::exists(saved) && read_file(saved) != cameras_json(train_cameras_))
+    fail_file(saved,
+              "the run trained on other cameras than the scene given now: resume with the same "
+              "scene and --downscale");
 }
 
 std::vector<int> Trainer::pick_views() {

@@ -78,7 +78,8 @@ class Trainer {
 
  private:
   void load_checkpoint();
-  double step(int64_t iteration);  // one optimizer step; returns the loss
+  void require_same_cameras() const;  // as the output folder's cameras.json
+  double step(int64_t iteration);     // one optimizer step; returns the loss
   std::vector<int> pick_views();
   void densify(int64_t iteration);
   int64_t densify_cap() const;  // config.max_gaussians, or fewer when memory runs short

@@ -132,6 +132,10 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   EXPECT_EQ(longer.status, 1);
   EXPECT_TRUE(contains(last_line(longer.output), "--iterations cannot change a resumed run"))
       << longer.output;
+  const CliRun halved = iesrgs(train + " --resume --downscale 2");
+  EXPECT_EQ(halved.status, 1);
+  EXPECT_TRUE(contains(last_line(halved.output), "cameras.json: the run trained on other cameras"))
+      << halved.output;
   const CliRun reseeded = iesrgs(train + " --resume --seed 3");
   EXPECT_EQ(reseeded.status, 1);
   EXPECT_TRUE(contains(last_line(reseeded.output), "--seed cannot change a resumed run"))
