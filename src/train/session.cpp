@@ -39,7 +39,9 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
                                 const std::filesystem::path& init_ply) {
   if (!init_ply.empty()) {
     spdlog::info("starting from {}", init_ply.string());
-    return gs::model_from_splat_cloud(read_model(init_ply));
+    const SplatCloud cloud = read_model(init_ply);
+    if (cloud.size() == 0) fail_file(init_ply, "has no Gaussians to start training from");
+    return gs::model_from_splat_cloud(cloud);
   }
   if (config.init == "auto" && !scene.points.positions.empty()) {
     spdlog::info("starting from {} SfM points", scene.points.positions.size());

@@ -189,6 +189,15 @@ TEST_F(TrainerTest, ResumeWithoutCheckpointIsAClearError) {
       std::string::npos);
 }
 
+TEST_F(TrainerTest, EmptyStartingPlyIsAClearError) {
+  TempDir dir;
+  write_ply(dir / "empty.ply", SplatCloud{});
+  const std::string message =
+      error_message([&] { initial_model(scene_, config(), dir / "empty.ply"); });
+  EXPECT_NE(message.find("empty.ply: has no Gaussians to start training from"), std::string::npos)
+      << message;
+}
+
 TEST_F(TrainerTest, PointCloudsRoundTripThroughPly) {
   TempDir out;
   Trainer trainer(config(), setup(out.path()), initial());
