@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
+
 #include "io/atomic_file.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
@@ -53,6 +55,29 @@ TEST(TrainingStage, NewSettingsNeverResumeAnOlderSettingsCheckpoint) {
   const auto start = [&] { return train::initial_model(run.scene, run.config, {}); };
   const StageResult result = run_training_stage("stage", {}, run.config, run.setup, start);
   EXPECT_GT(result.model.size(), 0);
+  EXPECT_TRUE(training_stage_current(dir / "stage", {}, run.config));
+}
+
+// Rerun after Ctrl-C, a stage continues from its checkpoint and builds no starting model.
+TEST(TrainingStage, InterruptedStageResumesFromItsCheckpoint) {
+  TempDir dir;
+  StageRun run = tiny_stage(dir / "scene", dir / "stage");
+  run.config.iterations = 12;
+  run.config.views_per_iteration = 1;
+  int steps = 0;
+  run.setup.loss = [&](int view, const raster::RenderOutput& render) {
+    if (++steps == 5) std::raise(SIGINT);  // checkpoints after iteration 5 and stops
+    return (render.image - run.setup.train_views[size_t(view)].target).abs().mean();
+  };
+  const auto start = [&] { return train::initial_model(run.scene, run.config, {}); };
+  const std::string message = testing::error_message(
+      [&] { run_training_stage("stage", {}, run.config, run.setup, start); });
+  EXPECT_TRUE(testing::contains(message, "interrupted at iteration 5")) << message;
+
+  const auto no_new_start = []() -> gs::GaussianModel { throw std::runtime_error("drawn"); };
+  const StageResult resumed = run_training_stage("stage", {}, run.config, run.setup, no_new_start);
+  EXPECT_EQ(steps, 12);
+  EXPECT_FALSE(resumed.cached);
   EXPECT_TRUE(training_stage_current(dir / "stage", {}, run.config));
 }
 
