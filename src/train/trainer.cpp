@@ -82,6 +82,19 @@ bool all_finite(const gs::GaussianModel& model) {
 // random points).
 constexpr int64_t kBytesPerGaussian = 1400;
 
+gs::DensifyOptions densify_options(const TrainConfig& c, int64_t iteration) {
+  gs::DensifyOptions options;
+  options.grad_threshold = c.grad_threshold;
+  options.source =
+      c.absolute_gradients ? gs::GradientSource::Absolute : gs::GradientSource::Viewspace;
+  options.percent_dense = c.percent_dense;
+  options.min_opacity = c.min_opacity;
+  const bool after_reset = iteration > c.opacity_reset_every;
+  options.max_screen_size = after_reset ? c.max_screen_size : 0;
+  options.max_world_size = after_reset ? c.max_world_size : 0;
+  return options;
+}
+
 }  // namespace
 
 void require_training_memory(int64_t gaussians) {
@@ -214,26 +227,11 @@ void Trainer::densify(int64_t iteration) {
   const TrainConfig& c = config_;
   if (iteration < c.densify_until) {
     if (iteration > c.densify_from && iteration % c.densify_every == 0) {
-      gs::DensifyOptions options;
-      options.grad_threshold = c.grad_threshold;
-      options.source =
-          c.absolute_gradients ? gs::GradientSource::Absolute : gs::GradientSource::Viewspace;
-      options.percent_dense = c.percent_dense;
-      options.min_opacity = c.min_opacity;
-      const bool after_reset = iteration > c.opacity_reset_every;
-      options.max_screen_size = after_reset ? c.max_screen_size : 0;
-      options.max_world_size = after_reset ? c.max_world_size : 0;
+      gs::DensifyOptions options = densify_options(c, iteration);
       options.max_gaussians = densify_cap();
       const gs::DensifyCounts counts =
           gs::densify_and_prune(model_, *optimizer_, stats_, options, setup_.scene_extent);
-      const bool below_config = c.max_gaussians == 0 || options.max_gaussians < c.max_gaussians;
-      if (counts.held_back > 0 && below_config && !memory_capped_) {
-        memory_capped_ = true;
-        spdlog::warn(
-            "iteration {}: densification stops at {} Gaussians, as many as the available memory "
-            "holds ({} more were due to clone or split)",
-            iteration, options.max_gaussians, counts.held_back);
-      }
+      if (counts.held_back > 0) warn_memory_cap(iteration, options.max_gaussians, counts.held_back);
       gs::update_filter_3d(model_, train_cameras_);
     }
     const bool white = setup_.background == std::array<float, 3>{1, 1, 1};
@@ -243,6 +241,16 @@ void Trainer::densify(int64_t iteration) {
     // As Mip-Splatting: keep the filter current, but not in the last steps.
     gs::update_filter_3d(model_, train_cameras_);
   }
+}
+
+void Trainer::warn_memory_cap(int64_t iteration, int64_t cap, int64_t held_back) {
+  // The config's cap is the user's choice; the memory's is worth saying, once.
+  if (memory_capped_ || (config_.max_gaussians > 0 && cap >= config_.max_gaussians)) return;
+  memory_capped_ = true;
+  spdlog::warn(
+      "iteration {}: densification stops at {} Gaussians, as many as the available memory holds "
+      "({} more were due to clone or split)",
+      iteration, cap, held_back);
 }
 
 int64_t Trainer::densify_cap() const {

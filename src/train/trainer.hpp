@@ -83,6 +83,7 @@ class Trainer {
   std::vector<int> pick_views();
   void densify(int64_t iteration);
   int64_t densify_cap() const;  // config.max_gaussians, or fewer when memory runs short
+  void warn_memory_cap(int64_t iteration, int64_t cap, int64_t held_back);
   void save_checkpoint();
   [[noreturn]] void fail_diverged(int64_t iteration, double loss) const;
   double report_test_psnr();
