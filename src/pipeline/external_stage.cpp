@@ -17,6 +17,7 @@
 #include "priors/sr/esrgan.hpp"
 #include "priors/sr/registry.hpp"
 #include "priors/sr/sr_net.hpp"
+#include "train/progress.hpp"
 
 namespace iesrgs::pipeline {
 
@@ -110,8 +111,10 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
     ++computed;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    fmt::print("external {}/{} {}: {:.2f} s per view\n", i + 1, cameras.size(), camera.name,
-               seconds / double(computed));
+    const double per_view = seconds / double(computed);
+    // The views left may be cached: the estimate errs long.
+    fmt::print("external {}/{} {}: {:.2f} s per view, ETA {}\n", i + 1, cameras.size(), camera.name,
+               per_view, train::format_duration(per_view * double(cameras.size() - i - 1)));
     std::fflush(stdout);
   }
   fmt::print("external stage: {} views computed, {} reused from {}\n", computed,
