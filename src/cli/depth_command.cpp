@@ -11,6 +11,7 @@
 #include "io/image_tensor.hpp"
 #include "priors/depth/depth_files.hpp"
 #include "priors/depth/depth_net.hpp"
+#include "train/progress.hpp"
 
 namespace iesrgs::cli {
 
@@ -29,13 +30,16 @@ void run_depth(const DepthArgs& args) {
       priors::depth::make_depth_net(args.model, args.weights);
   if (!net) fail("depth: model '{}' predicts nothing, so there is nothing to write", args.model);
   const float background[3] = {args.background, args.background, args.background};
+  const auto first = std::chrono::steady_clock::now();
   for (size_t i = 0; i < jobs.size(); ++i) {
     const auto start = std::chrono::steady_clock::now();
     const Image rgb = composite_rgb(read_image8(jobs[i].image), background);
     priors::depth::write_depth_outputs(net->predict(to_tensor(rgb)), jobs[i]);
-    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
-    fmt::print("[{}/{}] {} -> {} ({}x{}, {:.2f} s)\n", i + 1, jobs.size(), jobs[i].image.string(),
-               jobs[i].npy.string(), rgb.width, rgb.height, elapsed.count());
+    const auto now = std::chrono::steady_clock::now();
+    const std::chrono::duration<double> elapsed = now - start, total = now - first;
+    fmt::print("[{}/{}] {} -> {} ({}x{}, {:.2f} s, ETA {})\n", i + 1, jobs.size(),
+               jobs[i].image.string(), jobs[i].npy.string(), rgb.width, rgb.height, elapsed.count(),
+               train::format_eta(i + 1, jobs.size(), total.count()));
   }
 }
 

@@ -19,6 +19,7 @@
 #include "priors/sr/registry.hpp"
 #include "priors/sr/sr_net.hpp"
 #include "priors/sr/tiling.hpp"
+#include "train/progress.hpp"
 
 namespace iesrgs::cli {
 
@@ -72,13 +73,16 @@ std::pair<int, int> upscale_one(SrNet& net, const UpscaleArgs& args, const Job& 
 void run(const UpscaleArgs& args) {
   const std::vector<Job> jobs = jobs_for(args.input, args.output);
   const std::unique_ptr<SrNet> net = priors::sr::make_sr_net(args.model, args.weights, args.scale);
+  const auto first = std::chrono::steady_clock::now();
   for (size_t i = 0; i < jobs.size(); ++i) {
     const auto start = std::chrono::steady_clock::now();
     const auto [width, height] = upscale_one(*net, args, jobs[i]);
-    const std::chrono::duration<double> seconds = std::chrono::steady_clock::now() - start;
-    fmt::print("[{}/{}] {} {}x{} -> {} {}x{} ({:.2f} s)\n", i + 1, jobs.size(),
+    const auto now = std::chrono::steady_clock::now();
+    const std::chrono::duration<double> seconds = now - start, total = now - first;
+    fmt::print("[{}/{}] {} {}x{} -> {} {}x{} ({:.2f} s, ETA {})\n", i + 1, jobs.size(),
                jobs[i].input.string(), width, height, jobs[i].output.string(), width * args.scale,
-               height * args.scale, seconds.count());
+               height * args.scale, seconds.count(),
+               train::format_eta(i + 1, jobs.size(), total.count()));
     std::fflush(stdout);
   }
 }

@@ -111,10 +111,10 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
     ++computed;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const double per_view = seconds / double(computed);
     // The views left may be cached: the estimate errs long.
     fmt::print("external {}/{} {}: {:.2f} s per view, ETA {}\n", i + 1, cameras.size(), camera.name,
-               per_view, train::format_duration(per_view * double(cameras.size() - i - 1)));
+               seconds / double(computed),
+               train::format_eta(computed, computed + cameras.size() - i - 1, seconds));
     std::fflush(stdout);
   }
   fmt::print("external stage: {} views computed, {} reused from {}\n", computed,

@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.hpp"
@@ -53,6 +54,11 @@ void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
   std::fflush(stdout);
   last_print_ = now;
   last_print_iteration_ = iteration;
+}
+
+std::string format_eta(size_t done, size_t total, double seconds) {
+  if (done == 0) return "?";
+  return format_duration(seconds / double(done) * double(total - std::min(done, total)));
 }
 
 std::string format_duration(double seconds) {

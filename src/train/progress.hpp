@@ -31,4 +31,7 @@ class ProgressLog {
 // "1h02m05s", "3m07s", "42s".
 std::string format_duration(double seconds);
 
+// The time left for `total` items when `done` of them took `seconds`, at their mean pace.
+std::string format_eta(size_t done, size_t total, double seconds);
+
 }  // namespace iesrgs::train
