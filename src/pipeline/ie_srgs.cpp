@@ -132,7 +132,7 @@ class Pipeline {
   gs::GaussianModel initial_hr_model() const;
   RowResult evaluate_row(const RowSpec& row, const gs::GaussianModel& model, const fs::path& dir);
   RowResult run_fusion_row(const RowSpec& row);
-  bool row_current(const RowSpec& row) const;
+  bool row_current(const RowSpec& row, bool internal_current) const;
   void keep_earlier_rows(RunResult& result) const;
   void write_fusion_diagnostics(const gs::GaussianModel& model, const FusionSetup& setup) const;
   void write_mask_agreement(const FusionSetup& setup) const;
@@ -451,12 +451,9 @@ RunResult Pipeline::run() {
   return result;
 }
 
-bool Pipeline::row_current(const RowSpec& row) const {
+bool Pipeline::row_current(const RowSpec& row, bool internal_current) const {
   if (row.source == Source::HighRes && !hr_images_) return false;
-  if (row_uses_internal(row) &&
-      !internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
-                              o_.output / "internal"))
-    return false;
+  if (row_uses_internal(row) && !internal_current) return false;
   return row.source == Source::Internal ||
          training_stage_current(o_.output / "rows" / row.id, row_params(row, row_weights(row)),
                                 o_.fusion_config);
@@ -474,12 +471,16 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
   };
   if (!same("test_views")) return;
   const bool same_lpips = same("lpips");
+  // Asked once: the check decodes every cached render. A stage this run used is current.
+  const bool internal_current =
+      internal_.has_value() || internal_stage_current(lr_scene_, train_digest_, o_.internal_config,
+                                                      o_.scale, o_.output / "internal");
   const nlohmann::json rows = earlier.value("rows", nlohmann::json::array());
   for (const nlohmann::json& entry : rows.is_array() ? rows : nlohmann::json::array()) {
     try {
       const RowSpec* row = find_row(entry.at("row").get<std::string>());
       if (!row || std::find(rows_.begin(), rows_.end(), row->id) != rows_.end() ||
-          !row_current(*row))
+          !row_current(*row, internal_current))
         continue;
       result.rows.push_back(earlier_row(*row, row_label(*row), entry));
       if (!same_lpips) result.rows.back().mean.lpips.reset();
