@@ -149,10 +149,10 @@ void Trainer::load_checkpoint() {
   const std::filesystem::path path = checkpoint_path();
   if (!std::filesystem::exists(path))
     fail_file(path, "no checkpoint to resume from (train without --resume first)");
+  require_same_cameras();  // before reading a checkpoint that may not fit these views
   gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}},
                               {"seconds", {}},   {"loss", {}},     {"test_psnr", {}}};
   gs::load_training_state(path, model_, *optimizer_, stats_, &extras);
-  require_same_cameras();
   for (const char* required : {"iteration", "view_rng", "torch_rng"})
     if (!extras[required].defined())
       fail_file(path, fmt::format("not a training checkpoint of iesrgs train (no {})", required));
@@ -176,7 +176,7 @@ void Trainer::load_checkpoint() {
 void Trainer::require_same_cameras() const {
   // Resuming on other views (another --downscale, another scene) would go on training the model
   // on images it did not start from.
-  const std::filesystem::path saved = setup_.output_dir / "cameras.json";
+  const std::filesystem::path saved = cameras_path();
   if (std::filesystem::exists(saved) && read_file(saved) != cameras_json(train_cameras_))
     fail_file(saved,
               "the run trained on other cameras than the scene given now: resume with the same "
@@ -303,7 +303,7 @@ TrainSummary Trainer::run() {
   InterruptScope interrupt_scope;
   TrainSummary summary;
   ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations);
-  write_cameras_json(setup_.output_dir / "cameras.json", train_cameras_);
+  write_cameras_json(cameras_path(), train_cameras_);
   run_start_ = std::chrono::steady_clock::now();
   while (iteration_ < config_.iterations) {
     last_loss_ = step(iteration_ + 1);
