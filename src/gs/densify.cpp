@@ -86,14 +86,16 @@ Tensor mean_gradient(const DensifyStats& stats, GradientSource source) {
   return torch::where(stats.count > 0, sum / stats.count.clamp_min(1), torch::zeros_like(sum));
 }
 
-// `selected` narrowed to its `budget` Gaussians of the largest gradient when it holds more.
-Tensor within_budget(const Tensor& selected, const Tensor& gradient, int64_t budget) {
+// Narrows `selected` to its `budget` Gaussians of the largest gradient when it holds more;
+// returns how many it left out.
+int64_t keep_within_budget(Tensor& selected, const Tensor& gradient, int64_t budget) {
   const Tensor candidates = selected.nonzero().squeeze(1);
-  if (candidates.size(0) <= budget) return selected;
+  const int64_t surplus = candidates.size(0) - budget;
+  if (surplus <= 0) return 0;
   const Tensor best = std::get<1>(gradient.index({candidates}).topk(budget));
-  Tensor kept = torch::zeros_like(selected);
-  kept.index_put_({candidates.index({best})}, true);
-  return kept;
+  selected = torch::zeros_like(selected);
+  selected.index_put_({candidates.index({best})}, true);
+  return surplus;
 }
 
 Tensor prune_mask(const GaussianModel& model, const DensifyStats& stats,
@@ -154,11 +156,9 @@ DensifyCounts densify_and_prune(GaussianModel& model, GaussianOptimizer& optimiz
   const Tensor gradient = mean_gradient(stats, options.source);
   Tensor selected = gradient >= options.grad_threshold;
   DensifyCounts counts;
-  if (options.max_gaussians > 0) {  // each clone and each split adds one Gaussian
-    const int64_t wanted = selected.sum().item<int64_t>();
-    selected = within_budget(selected, gradient, std::max<int64_t>(0, options.max_gaussians - n));
-    counts.held_back = wanted - selected.sum().item<int64_t>();
-  }
+  if (options.max_gaussians > 0)  // each clone and each split adds one Gaussian
+    counts.held_back =
+        keep_within_budget(selected, gradient, std::max<int64_t>(0, options.max_gaussians - n));
   const Tensor large = max_scale(model) > options.percent_dense * scene_extent;
   const Tensor clone = selected & ~large, split = selected & large;
   counts.cloned = clone.sum().item<int64_t>();
