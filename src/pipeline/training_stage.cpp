@@ -56,14 +56,15 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
     return {gs::model_from_splat_cloud(read_cached_output(dir / "point_cloud.ply", read_ply)),
             stage_seconds(dir), true};
   }
-  const bool resumable = stage_json(dir).value("params", nlohmann::json()) == identity &&
-                         fs::exists(train::checkpoint_path(dir));
+  const fs::path checkpoint = train::checkpoint_path(dir);
+  const bool resumable =
+      stage_json(dir).value("params", nlohmann::json()) == identity && fs::exists(checkpoint);
   if (!resumable) {  // an older run's checkpoint would be resumed by the next identical run
     fs::remove(dir / "train_log.csv");
-    fs::remove(train::checkpoint_path(dir));
+    fs::remove(checkpoint);
   }
   record_stage(dir, identity, false, 0);
-  if (resumable) fmt::print("{}: resuming from {}\n", name, train::checkpoint_path(dir).string());
+  if (resumable) fmt::print("{}: resuming from {}\n", name, checkpoint.string());
   train::Trainer trainer = resumable ? train::Trainer::resumed(config, std::move(setup))
                                      : train::Trainer(config, std::move(setup), initial_model());
   const train::TrainSummary summary = trainer.run();
