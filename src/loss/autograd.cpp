@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include <ATen/ATen.h>
 #include <torch/csrc/autograd/custom_function.h>
@@ -10,6 +11,9 @@
 #include "loss/pearson.hpp"
 #include "loss/ssim.hpp"
 #include "loss/texture_fusion.hpp"
+#ifdef IESRGS_WITH_CUDA
+#include "loss/cuda/ssim.hpp"
+#endif
 
 namespace iesrgs::loss {
 
@@ -36,8 +40,9 @@ auto with_scalar_type(const at::Tensor& tensor, Body&& body) {
 
 void check_pair(const char* what, const at::Tensor& value, const at::Tensor& target) {
   if (!value.defined() || !target.defined()) fail("{}: undefined tensor", what);
-  if (value.device().type() != at::kCPU || target.device().type() != at::kCPU)
-    fail("{}: tensors must be on the CPU", what);
+  if (value.device() != target.device())
+    fail("{}: the target is on {}, the value on {}", what, c10::str(target.device()),
+         c10::str(value.device()));
   if (value.scalar_type() != at::kFloat && value.scalar_type() != at::kDouble)
     fail("{}: dtype {} is not float32 or float64", what, c10::toString(value.scalar_type()));
   if (target.scalar_type() != value.scalar_type())
@@ -47,6 +52,25 @@ void check_pair(const char* what, const at::Tensor& value, const at::Tensor& tar
     fail("{}: target shape {} differs from {}", what, c10::str(target.sizes()),
          c10::str(value.sizes()));
   if (target.requires_grad()) fail("{}: the target must not require grad", what);
+}
+
+// Pearson has no CUDA kernel: device tensors run the CPU one on host copies, two image-sized
+// transfers per view.
+at::Tensor on_host(const at::Tensor& t) {
+  return t.device().is_cpu() ? t.contiguous() : t.to(at::kCPU).contiguous();
+}
+
+#ifdef IESRGS_WITH_CUDA
+// One SSIM workspace per thread, grown to the largest image and kept.
+cuda::Ssim& device_ssim() {
+  static thread_local cuda::Ssim* ssim = new cuda::Ssim;  // outlives the CUDA context
+  return *ssim;
+}
+#endif
+
+void require_float_on_gpu(const at::Tensor& x, const char* what) {
+  if (x.is_cuda() && x.scalar_type() != at::kFloat)
+    fail("{}: CUDA tensors must be float32, not {}", what, c10::toString(x.scalar_type()));
 }
 
 class SsimFunction : public torch::autograd::Function<SsimFunction> {
@@ -59,6 +83,12 @@ class SsimFunction : public torch::autograd::Function<SsimFunction> {
     at::Tensor partials = at::empty({int64_t(ssim_partials_size(shape))}, x.options());
     const double mean = with_scalar_type(x, [&](auto zero) {
       using T = decltype(zero);
+#ifdef IESRGS_WITH_CUDA
+      if constexpr (std::is_same_v<T, float>)
+        if (x.is_cuda())
+          return device_ssim().forward(x.data_ptr<float>(), y.data_ptr<float>(), shape,
+                                       map.data_ptr<float>(), partials.data_ptr<float>());
+#endif
       return ssim<T>(x.data_ptr<T>(), y.data_ptr<T>(), shape, map.data_ptr<T>(),
                      partials.data_ptr<T>());
     });
@@ -76,6 +106,13 @@ class SsimFunction : public torch::autograd::Function<SsimFunction> {
     at::Tensor grad_x = at::zeros_like(x);
     with_scalar_type(x, [&](auto zero) {
       using T = decltype(zero);
+#ifdef IESRGS_WITH_CUDA
+      if constexpr (std::is_same_v<T, float>)
+        if (x.is_cuda())
+          return device_ssim().backward(x.data_ptr<float>(), y.data_ptr<float>(), shape,
+                                        partials.data_ptr<float>(), weight.data_ptr<float>(),
+                                        grad_x.data_ptr<float>());
+#endif
       ssim_backward<T>(x.data_ptr<T>(), y.data_ptr<T>(), shape, partials.data_ptr<T>(),
                        weight.data_ptr<T>(), grad_x.data_ptr<T>());
     });
@@ -87,15 +124,15 @@ class PearsonFunction : public torch::autograd::Function<PearsonFunction> {
  public:
   static at::Tensor forward(AutogradContext* ctx, const at::Tensor& a_in, const at::Tensor& b_in,
                             const at::Tensor& mask_in) {
-    const at::Tensor a = a_in.contiguous(), b = b_in.contiguous();
-    const at::Tensor mask = mask_in.to(at::kByte).contiguous();
+    const at::Tensor a = on_host(a_in), b = on_host(b_in);
+    const at::Tensor mask = on_host(mask_in.to(at::kByte));
     const double correlation = with_scalar_type(a, [&](auto zero) {
       using T = decltype(zero);
       return pearson_correlation<T>(a.data_ptr<T>(), b.data_ptr<T>(), mask.data_ptr<uint8_t>(),
                                     a.numel());
     });
     ctx->save_for_backward({a, b, mask});
-    return at::scalar_tensor(correlation, a.options());
+    return at::scalar_tensor(correlation, a_in.options());
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
@@ -107,7 +144,7 @@ class PearsonFunction : public torch::autograd::Function<PearsonFunction> {
       pearson_correlation_backward<T>(a.data_ptr<T>(), b.data_ptr<T>(), mask.data_ptr<uint8_t>(),
                                       a.numel(), grads[0].item<double>(), grad_a.data_ptr<T>());
     });
-    return {grad_a, at::Tensor(), at::Tensor()};
+    return {grad_a.to(grads[0].device()), at::Tensor(), at::Tensor()};
   }
 };
 
@@ -142,15 +179,15 @@ class GuidedTextureFunction : public torch::autograd::Function<GuidedTextureFunc
 
 SsimTensors ssim_autograd(const at::Tensor& x, const at::Tensor& y) {
   check_pair("ssim", x, y);
+  require_float_on_gpu(x, "ssim");
   const variable_list out = SsimFunction::apply(x, y);
   return {out[0], out[1]};
 }
 
 at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
   check_pair("pearson", a, b);
-  if (mask.defined() && (mask.sizes() != a.sizes() || mask.device().type() != at::kCPU))
-    fail("pearson: mask must be a CPU tensor of shape {}, not {} on {}", c10::str(a.sizes()),
-         c10::str(mask.sizes()), c10::str(mask.device()));
+  if (mask.defined() && mask.sizes() != a.sizes())
+    fail("pearson: mask must have shape {}, not {}", c10::str(a.sizes()), c10::str(mask.sizes()));
   // autograd::Function takes defined tensors only.
   return PearsonFunction::apply(a, b, mask.defined() ? mask : at::ones(a.sizes(), at::kByte));
 }
@@ -165,8 +202,31 @@ at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& i
       internal_share.scalar_type() != render.scalar_type())
     fail("guided texture: the internal share must be a {} map of the render's dtype",
          c10::str(expected));
+  if (render.is_cuda())
+    return guided_texture_from_ops(render, internal, external, internal_share, dssim_weight);
   return GuidedTextureFunction::apply(render, internal.defined() ? internal : at::empty({0}),
                                       external, internal_share, dssim_weight);
+}
+
+at::Tensor guided_texture_from_ops(const at::Tensor& render, const at::Tensor& internal,
+                                   const at::Tensor& external, const at::Tensor& internal_share,
+                                   double dssim_weight) {
+  const double pixels = double(internal_share.numel());
+  // mean_p share(p) * ((1 - w) * l1_map(p) + w * (1 - ssim_map(p))) against one reference.
+  const auto term = [&](const at::Tensor& reference, const at::Tensor& share) {
+    const at::Tensor l1_map = (render - reference).abs().mean(0);
+    const at::Tensor ssim_map = ssim_autograd(render, reference).map;
+    return (share * ((1 - dssim_weight) * l1_map + dssim_weight * (1 - ssim_map))).sum() / pixels;
+  };
+  at::Tensor loss = at::zeros({}, render.options());
+  // As the kernel, a reference whose share is zero everywhere is not evaluated.
+  if (internal_share.ne(0).any().item<bool>()) {
+    if (!internal.defined()) fail("guided_texture_loss: internal share without an image");
+    loss = loss + term(internal, internal_share);
+  }
+  const at::Tensor external_share = 1 - internal_share;
+  if (external_share.ne(0).any().item<bool>()) loss = loss + term(external, external_share);
+  return loss;
 }
 
 }  // namespace iesrgs::loss

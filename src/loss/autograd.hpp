@@ -32,4 +32,10 @@ at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& i
                                    const at::Tensor& external, const at::Tensor& internal_share,
                                    double dssim_weight);
 
+// The same loss composed of tensor ops around ssim_autograd, which is what tensors on a GPU take
+// (the kernel of loss/texture_fusion.hpp works on host arrays); equal in value and gradient.
+at::Tensor guided_texture_from_ops(const at::Tensor& render, const at::Tensor& internal,
+                                   const at::Tensor& external, const at::Tensor& internal_share,
+                                   double dssim_weight);
+
 }  // namespace iesrgs::loss

@@ -2,10 +2,17 @@
 
 #include <torch/autograd.h>
 
+#include <memory>
+#include <mutex>
+#include <vector>
+
 #include "core/error.hpp"
 #include "gs/sh.hpp"
 #include "raster/frame.hpp"
 #include "raster/rasterizer.hpp"
+#ifdef IESRGS_WITH_CUDA
+#include "raster/cuda/rasterizer.hpp"
+#endif
 
 namespace iesrgs::raster {
 
@@ -15,30 +22,77 @@ using torch::Tensor;
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
-// Keeps the forward pass's frame alive until backward, inside the autograd context.
-struct FrameHolder : torch::CustomClassHolder {
-  RasterFrame<float> frame;
+#ifdef IESRGS_WITH_CUDA
+// CUDA rasterizers whose frames autograd has let go of: their device buffers, grown to the
+// scene, serve the next frames instead of being allocated and freed for each.
+class RasterizerPool {
+ public:
+  std::unique_ptr<cuda::Rasterizer> take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (free_.empty()) return std::make_unique<cuda::Rasterizer>();
+    std::unique_ptr<cuda::Rasterizer> rasterizer = std::move(free_.back());
+    free_.pop_back();
+    return rasterizer;
+  }
+  void give_back(std::unique_ptr<cuda::Rasterizer> rasterizer) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(std::move(rasterizer));
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<cuda::Rasterizer>> free_;
 };
 
-void check_tensor(const Tensor& t, const char* name, std::initializer_list<int64_t> shape) {
+RasterizerPool& rasterizer_pool() {
+  static RasterizerPool* pool = new RasterizerPool;  // never destroyed: outlives the CUDA context
+  return *pool;
+}
+#endif
+
+// Keeps the forward pass's frame alive until backward, inside the autograd context: the CPU
+// rasterizer's frame, or the CUDA rasterizer that holds the frame's device buffers.
+struct FrameHolder : torch::CustomClassHolder {
+  RasterFrame<float> frame;
+#ifdef IESRGS_WITH_CUDA
+  std::unique_ptr<cuda::Rasterizer> device;
+  ~FrameHolder() override {
+    if (device) rasterizer_pool().give_back(std::move(device));
+  }
+#endif
+};
+
+void check_tensor(const Tensor& t, const char* name, std::initializer_list<int64_t> shape,
+                  const torch::Device& device) {
   if (!t.defined()) fail("render: {} is missing", name);
-  if (t.scalar_type() != torch::kFloat32 || !t.device().is_cpu())
-    fail("render: {} must be a float32 CPU tensor", name);
+  if (t.scalar_type() != torch::kFloat32) fail("render: {} must be a float32 tensor", name);
+  if (t.device() != device)
+    fail("render: {} is on {}, the Gaussians' means on {}", name, c10::str(t.device()),
+         c10::str(device));
   if (t.sizes() != c10::IntArrayRef(shape))
     fail("render: {} has shape {}, expected {}", name, c10::str(t.sizes()),
          c10::str(c10::IntArrayRef(shape)));
 }
 
 void check_inputs(const GaussianTensors& g, const ViewspaceProbes& probes) {
-  const int64_t n = g.means.defined() ? g.means.size(0) : 0;
-  check_tensor(g.means, "means", {n, 3});
-  check_tensor(g.log_scales, "log_scales", {n, 3});
-  check_tensor(g.quats, "quats", {n, 4});
-  check_tensor(g.opacity_logits, "opacity_logits", {n});
-  check_tensor(g.sh, "sh", {n, gs::kShCoefficients, 3});
-  if (g.filter_std.defined()) check_tensor(g.filter_std, "filter_std", {n});
-  if (probes.grad.defined()) check_tensor(probes.grad, "viewspace probe", {n, 2});
-  if (probes.abs_grad.defined()) check_tensor(probes.abs_grad, "viewspace abs probe", {n, 2});
+  if (!g.means.defined()) fail("render: means is missing");
+  const torch::Device device = g.means.device();
+#ifdef IESRGS_WITH_CUDA
+  const bool supported = device.is_cpu() || device.is_cuda();
+#else
+  const bool supported = device.is_cpu();
+#endif
+  if (!supported) fail("render: this build has no rasterizer for tensors on {}", c10::str(device));
+  const int64_t n = g.means.size(0);
+  check_tensor(g.means, "means", {n, 3}, device);
+  check_tensor(g.log_scales, "log_scales", {n, 3}, device);
+  check_tensor(g.quats, "quats", {n, 4}, device);
+  check_tensor(g.opacity_logits, "opacity_logits", {n}, device);
+  check_tensor(g.sh, "sh", {n, gs::kShCoefficients, 3}, device);
+  if (g.filter_std.defined()) check_tensor(g.filter_std, "filter_std", {n}, device);
+  if (probes.grad.defined()) check_tensor(probes.grad, "viewspace probe", {n, 2}, device);
+  if (probes.abs_grad.defined())
+    check_tensor(probes.abs_grad, "viewspace abs probe", {n, 2}, device);
 }
 
 GaussianParams<float> params_of(const Tensor& means, const Tensor& log_scales, const Tensor& quats,
@@ -57,7 +111,7 @@ GaussianParams<float> params_of(const Tensor& means, const Tensor& log_scales, c
   return g;
 }
 
-const float* data_or_null(const Tensor& t) {
+float* data_or_null(const Tensor& t) {
   return t.defined() ? t.data_ptr<float>() : nullptr;
 }
 
@@ -79,14 +133,20 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     const GaussianParams<float> g =
         params_of(means, log_scales, quats, logits, sh, filter_std, int(sh_degree), antialiased);
     auto holder = c10::make_intrusive<FrameHolder>();
-    const auto f32 = torch::TensorOptions().dtype(torch::kFloat32);
+    const auto f32 = means.options();
     Tensor image = torch::empty({3, camera.height, camera.width}, f32);
     Tensor alpha = torch::empty({camera.height, camera.width}, f32);
     Tensor depth = torch::empty({camera.height, camera.width}, f32);
     Tensor radii = torch::empty({g.count}, f32.dtype(torch::kInt32));
-    rasterize_forward(g, camera, background.data(), holder->frame,
-                      RenderTargets<float>{image.data_ptr<float>(), alpha.data_ptr<float>(),
-                                           depth.data_ptr<float>(), radii.data_ptr<int32_t>()});
+    const RenderTargets<float> targets{image.data_ptr<float>(), alpha.data_ptr<float>(),
+                                       depth.data_ptr<float>(), radii.data_ptr<int32_t>()};
+#ifdef IESRGS_WITH_CUDA
+    if (means.is_cuda()) {
+      holder->device = rasterizer_pool().take();
+      holder->device->forward(g, camera, background.data(), targets);
+    } else
+#endif
+      rasterize_forward(g, camera, background.data(), holder->frame, targets);
     ctx->save_for_backward({means, log_scales, quats, logits, sh, filter_std});
     ctx->saved_data["frame"] = c10::IValue::make_capsule(holder);
     ctx->saved_data["sh_degree"] = sh_degree;
@@ -116,14 +176,18 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     std::array<Tensor, 3> pixel;
     for (int i = 0; i < 3; ++i)
       if (grad_outputs[i].defined()) pixel[i] = grad_outputs[i].contiguous();
-    rasterize_backward(
-        g, holder->frame,
-        PixelGrads<float>{data_or_null(pixel[0]), data_or_null(pixel[1]), data_or_null(pixel[2])},
-        GaussianGrads<float>{dmeans.data_ptr<float>(), dlog_scales.data_ptr<float>(),
-                             dquats.data_ptr<float>(), dlogits.data_ptr<float>(),
-                             dsh.data_ptr<float>(),
-                             dprobe.defined() ? dprobe.data_ptr<float>() : nullptr,
-                             dabs_probe.defined() ? dabs_probe.data_ptr<float>() : nullptr});
+    const PixelGrads<float> pixel_grads{data_or_null(pixel[0]), data_or_null(pixel[1]),
+                                        data_or_null(pixel[2])};
+    const GaussianGrads<float> grads{dmeans.data_ptr<float>(), dlog_scales.data_ptr<float>(),
+                                     dquats.data_ptr<float>(), dlogits.data_ptr<float>(),
+                                     dsh.data_ptr<float>(),    data_or_null(dprobe),
+                                     data_or_null(dabs_probe)};
+#ifdef IESRGS_WITH_CUDA
+    if (holder->device)
+      holder->device->backward(g, pixel_grads, grads);
+    else
+#endif
+      rasterize_backward(g, holder->frame, pixel_grads, grads);
     return {dmeans,     dlog_scales, dquats,   dlogits,  dsh,      Tensor(), dprobe,
             dabs_probe, Tensor(),    Tensor(), Tensor(), Tensor(), Tensor()};
   }
@@ -134,7 +198,9 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
 RenderOutput render(const GaussianTensors& gaussians, const RasterCamera<float>& camera,
                     const std::array<float, 3>& background, const ViewspaceProbes& probes) {
   check_inputs(gaussians, probes);
-  const auto or_placeholder = [](const Tensor& t) { return t.defined() ? t : torch::empty({0}); };
+  const auto or_placeholder = [&](const Tensor& t) {
+    return t.defined() ? t : torch::empty({0}, gaussians.means.options());
+  };
   const variable_list out = RasterizeFunction::apply(
       gaussians.means, gaussians.log_scales, gaussians.quats, gaussians.opacity_logits,
       gaussians.sh, or_placeholder(gaussians.filter_std), or_placeholder(probes.grad),

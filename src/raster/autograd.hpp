@@ -1,6 +1,7 @@
 #pragma once
-// LibTorch front end of the CPU rasterizer: a differentiable render() for losses written with
-// tensors. Float32 CPU tensors; the kernels themselves never see torch.
+// LibTorch front end of the rasterizer: a differentiable render() for losses written with
+// tensors. Float32 tensors, on the CPU or (CUDA builds) a GPU, where the matching kernels run;
+// the kernels themselves never see torch.
 #include <torch/types.h>
 
 #include <array>

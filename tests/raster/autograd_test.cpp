@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "raster_test_scene.hpp"
+#include "support/cuda_device.hpp"
 
 namespace iesrgs::raster::testkit {
 namespace {
@@ -94,6 +95,62 @@ TEST(RasterAutograd, FilterAndProbesAreOptional) {
   zero_filter.image.sum().backward();
   EXPECT_TRUE(torch::equal(zero_filter.image, plain.image));
   EXPECT_TRUE(torch::equal(g.means.grad(), grad_without_filter));
+}
+
+// The CUDA kernels behind render(): the same images and gradients as the CPU ones. Alphas within
+// rounding of the 1/255 cut-off may flip at a few pixels (one splat's contribution).
+TEST(RasterAutograd, CudaMatchesCpu) {
+  IESRGS_SKIP_WITHOUT_CUDA();
+  const Camera cam = posed_test_camera(120, 96);
+  const Scene<float> s = random_scene(cam, 3000, 3, 29).cast<float>();
+  const int64_t n = s.count();
+  const GaussianTensors cpu{tensor_of(s.means, {n, 3}),
+                            tensor_of(s.log_scales, {n, 3}),
+                            tensor_of(s.quats, {n, 4}),
+                            tensor_of(s.opacity_logits, {n}),
+                            tensor_of(s.sh, {n, 16, 3}),
+                            torch::tensor(s.filter_std),
+                            s.sh_degree};
+  GaussianTensors gpu = cpu;
+  for (torch::Tensor* t :
+       {&gpu.means, &gpu.log_scales, &gpu.quats, &gpu.opacity_logits, &gpu.sh, &gpu.filter_std})
+    *t = testing::on_cuda(*t);
+  const auto probes_on = [&](torch::Device device) {
+    const auto options = torch::TensorOptions().device(device).requires_grad(true);
+    return ViewspaceProbes{torch::zeros({n, 2}, options), torch::zeros({n, 2}, options)};
+  };
+  const ViewspaceProbes cpu_probes = probes_on(torch::kCPU), gpu_probes = probes_on(torch::kCUDA);
+  torch::manual_seed(5);
+  const torch::Tensor wi = torch::rand({3, cam.intrinsics.height, cam.intrinsics.width});
+  const torch::Tensor wa = torch::rand({cam.intrinsics.height, cam.intrinsics.width});
+  const auto render_and_backward = [&](const GaussianTensors& g, const ViewspaceProbes& probes) {
+    const RenderOutput out = render(g, raster_camera<float>(cam), {0.3f, 0.6f, 0.9f}, probes);
+    const torch::Device device = out.image.device();
+    ((out.image * wi.to(device)).sum() + (out.alpha * wa.to(device)).sum() + 0.1 * out.depth.sum())
+        .backward();
+    return out;
+  };
+  const RenderOutput expected = render_and_backward(cpu, cpu_probes);
+  const RenderOutput actual = render_and_backward(gpu, gpu_probes);
+  ASSERT_TRUE(actual.image.is_cuda());
+  EXPECT_TRUE(torch::equal(actual.radii.cpu(), expected.radii));
+  for (const auto& [a, b] :
+       {std::pair{actual.image, expected.image}, std::pair{actual.alpha, expected.alpha}}) {
+    const torch::Tensor difference = (a.cpu() - b).abs();
+    EXPECT_LT(difference.mean().item<double>(), 1e-5);
+    EXPECT_LT(difference.max().item<double>(), 2e-3);
+  }
+  EXPECT_LT(testing::relative_difference(actual.depth, expected.depth), 1e-4);
+  const std::pair<const char*, std::pair<torch::Tensor, torch::Tensor>> grads[] = {
+      {"means", {gpu.means.grad(), cpu.means.grad()}},
+      {"log_scales", {gpu.log_scales.grad(), cpu.log_scales.grad()}},
+      {"quats", {gpu.quats.grad(), cpu.quats.grad()}},
+      {"opacity_logits", {gpu.opacity_logits.grad(), cpu.opacity_logits.grad()}},
+      {"sh", {gpu.sh.grad(), cpu.sh.grad()}},
+      {"viewspace", {gpu_probes.grad.grad(), cpu_probes.grad.grad()}},
+      {"viewspace_abs", {gpu_probes.abs_grad.grad(), cpu_probes.abs_grad.grad()}}};
+  for (const auto& [name, pair] : grads)
+    EXPECT_LT(testing::relative_difference(pair.first, pair.second), 1e-3) << name;
 }
 
 TEST(RasterAutograd, RejectsWrongShapes) {
