@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include "cli/commands.hpp"
+#include "cli/device_option.hpp"
 #include "cli/external_options.hpp"
 #include "cli/scene_options.hpp"
 #include "cli/validators.hpp"
@@ -39,9 +40,11 @@ struct RunArgs {
   std::string texture = "masked";
   std::vector<std::string> rows{"ie-srgs"};
   uint64_t seed = 0;
+  std::string device = "auto";
 };
 
 void run_pipeline(const RunArgs& args, pipeline::StageSelection only) {
+  use_device(args.device);
   pipeline::RunOptions options = args.options;
   options.scene = args.scene.path;
   options.scene_options = args.scene.resolved();
@@ -120,6 +123,7 @@ CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
       ->capture_default_str()
       ->check(kNonNegative);
   command->add_option("--seed", args->seed, "Random seed of both trainings")->capture_default_str();
+  add_device_option(*command, args->device);
   command->callback([args, only] { run_pipeline(*args, only); });
   return command;
 }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/device_option.hpp"
 #include "cli/scene_options.hpp"
 #include "cli/validators.hpp"
 #include "core/error.hpp"
@@ -28,6 +29,7 @@ struct TrainArgs {
   std::vector<std::string> assignments;
   std::string init_ply;
   bool resume = false;
+  std::string device = "auto";
 };
 
 nlohmann::json read_json_file(const std::filesystem::path& path) {
@@ -68,6 +70,7 @@ void refuse_changes_on_resume(const std::vector<const CLI::Option*>& run_options
 }
 
 void run_train(const TrainArgs& args) {
+  use_device(args.device);
   const std::filesystem::path out = args.output;
   const train::TrainConfig config = resolve_config(args, out / "config.json");
   if (!args.resume)
@@ -137,6 +140,7 @@ void add_train_command(CLI::App& app) {
   defines_run(command->add_option("--init-ply", args->init_ply,
                                   "Start from this 3DGS .ply, .spz or .splat instead"));
   command->add_flag("--resume", args->resume, "Continue the run in --output from its checkpoint");
+  add_device_option(*command, args->device);
   command->callback([args, run_options] {
     if (args->resume) refuse_changes_on_resume(run_options);
     run_train(*args);

@@ -72,7 +72,7 @@ void load_training_state(const std::filesystem::path& path, GaussianModel& model
                          CheckpointExtras* extras) {
   try {
     torch::serialize::InputArchive archive;
-    archive.load_from(path.string());
+    archive.load_from(path.string(), torch::kCPU);  // wherever it was trained
     GaussianModel loaded_model = load_model(archive);
     GaussianOptimizer loaded_optimizer = optimizer;
     loaded_optimizer.load_state(archive, loaded_model);

@@ -109,8 +109,14 @@ Tensor prune_mask(const GaussianModel& model, const DensifyStats& stats,
 
 }  // namespace
 
-DensifyStats DensifyStats::zeros(int64_t n) {
-  return {torch::zeros({n}), torch::zeros({n}), torch::zeros({n}), torch::zeros({n})};
+DensifyStats DensifyStats::zeros(int64_t n, torch::Device device) {
+  const auto options = torch::TensorOptions().device(device);
+  return {torch::zeros({n}, options), torch::zeros({n}, options), torch::zeros({n}, options),
+          torch::zeros({n}, options)};
+}
+
+void DensifyStats::to(torch::Device device) {
+  for (Tensor* t : {&grad_sum, &abs_grad_sum, &count, &max_radii}) *t = t->to(device);
 }
 
 void DensifyStats::accumulate(const std::vector<ViewStatistics>& views) {
@@ -170,14 +176,14 @@ DensifyCounts densify_and_prune(GaussianModel& model, GaussianOptimizer& optimiz
   append_rows(model, optimizer, clones);
   append_rows(model, optimizer, children);
   const int64_t added = model.size() - n;
-  stats.max_radii = torch::cat({stats.max_radii, torch::zeros({added})});  // unseen yet
-  const Tensor parent_gone =
-      torch::cat({split, torch::zeros({added}, torch::TensorOptions().dtype(torch::kBool))});
+  stats.max_radii =
+      torch::cat({stats.max_radii, torch::zeros({added}, stats.max_radii.options())});  // unseen
+  const Tensor parent_gone = torch::cat({split, torch::zeros({added}, split.options())});
 
   const Tensor keep = ~(parent_gone | prune_mask(model, stats, options, scene_extent));
   counts.pruned = model.size() - keep.sum().item<int64_t>() - counts.split;
   keep_rows(model, optimizer, keep);
-  stats = DensifyStats::zeros(model.size());
+  stats = DensifyStats::zeros(model.size(), model.means.device());
   return counts;
 }
 

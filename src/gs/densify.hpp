@@ -39,7 +39,9 @@ struct DensifyOptions {
 struct DensifyStats {
   torch::Tensor grad_sum, abs_grad_sum, count, max_radii;
 
-  static DensifyStats zeros(int64_t n);
+  static DensifyStats zeros(int64_t n, torch::Device device = torch::kCPU);
+  // Moves the accumulators to `device`, where the model's parameters are.
+  void to(torch::Device device);
   // Adds each view's gradient norms where that view drew the Gaussian, so all K views of a
   // multi-view iteration count.
   void accumulate(const std::vector<ViewStatistics>& views);

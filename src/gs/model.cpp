@@ -20,7 +20,7 @@ torch::Tensor tensor_of(const std::vector<float>& values, c10::IntArrayRef shape
 }
 
 std::vector<float> values_of(const torch::Tensor& t) {
-  const torch::Tensor c = t.detach().contiguous();
+  const torch::Tensor c = t.detach().to(torch::kCPU).contiguous();
   return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
 }
 
@@ -95,6 +95,13 @@ GaussianModel GaussianModel::clone() const {
   return copy;
 }
 
+GaussianModel GaussianModel::to(torch::Device device) const {
+  GaussianModel moved = *this;
+  for (int p = 0; p < kParamCount; ++p) moved.set_param(Param(p), param(Param(p)).to(device));
+  if (filter_3d.defined()) moved.filter_3d = filter_3d.to(device);
+  return moved;
+}
+
 void GaussianModel::set_param(Param p, const torch::Tensor& value) {
   param(p) = value.detach().clone().contiguous().requires_grad_(true);
 }
@@ -136,10 +143,10 @@ GaussianModel model_from_random_box(int count, float half_extent, uint64_t seed)
 }
 
 void update_filter_3d(GaussianModel& model, const std::vector<Camera>& cameras) {
-  const torch::Tensor means = model.means.detach().contiguous();
+  // On the CPU wherever the model is: it runs every few hundred iterations.
   const std::vector<float> std_dev =
-      filter3d_std(means.data_ptr<float>(), int(model.size()), cameras);
-  model.filter_3d = tensor_of(std_dev, {model.size()});
+      filter3d_std(values_of(model.means).data(), int(model.size()), cameras);
+  model.filter_3d = tensor_of(std_dev, {model.size()}).to(model.means.device());
 }
 
 SplatCloud to_splat_cloud(const GaussianModel& model) {

@@ -1,6 +1,7 @@
 #pragma once
-// The trainable Gaussian scene: 3DGS's parameters as LibTorch leaf tensors (float32, CPU), in
-// the raw pre-activation form that the rasterizer, the optimizer and the PLY files share.
+// The trainable Gaussian scene: 3DGS's parameters as LibTorch leaf tensors (float32, on the CPU
+// or the GPU that trains them), in the raw pre-activation form that the rasterizer, the optimizer
+// and the PLY files share.
 #include <torch/types.h>
 
 #include <array>
@@ -39,6 +40,8 @@ struct GaussianModel {
   // A copy that shares no storage with this model. Copying the struct shares the tensors, and
   // the optimizer updates them in place, so training such a copy would change this model too.
   GaussianModel clone() const;
+  // A copy on `device` (the CPU, or a GPU to train there), sharing no storage with this model.
+  GaussianModel to(torch::Device device) const;
 
   // The optimized tensor becomes a contiguous copy of `value`, a fresh leaf that requires grad.
   void set_param(Param p, const torch::Tensor& value);

@@ -6,6 +6,9 @@
 
 #include "core/error.hpp"
 #include "gs/adam.hpp"
+#ifdef IESRGS_WITH_CUDA
+#include "gs/cuda/adam.hpp"
+#endif
 
 namespace iesrgs::gs {
 
@@ -19,6 +22,17 @@ void adam_update(float* param, const float* grad, float* first, float* second, i
 #pragma omp parallel for simd schedule(static)
   for (int64_t i = 0; i < count; ++i)
     adam_update_value(param[i], grad[i], first[i], second[i], step_size, bias2_sqrt);
+}
+
+void device_adam_update(float* param, const float* grad, float* first, float* second, int64_t count,
+                        float step_size, float bias2_sqrt) {
+#ifdef IESRGS_WITH_CUDA
+  cuda::adam_update(param, grad, first, second, count, step_size, bias2_sqrt);
+#else
+  (void)param, (void)grad, (void)first, (void)second, (void)count, (void)step_size,
+      (void)bias2_sqrt;
+  fail("optimizer step: this build has no CUDA kernels");
+#endif
 }
 
 }  // namespace
@@ -70,10 +84,14 @@ void GaussianOptimizer::step(GaussianModel& model) {
     if (grad.sizes() != moments_[p].first.sizes() || !param.is_contiguous())
       fail("optimizer step: {} has shape {} but its moments {}", kParamNames[p],
            c10::str(grad.sizes()), c10::str(moments_[p].first.sizes()));
+    if (param.device() != moments_[p].first.device())
+      fail("optimizer step: {} is on {}, its moments on {}", kParamNames[p],
+           c10::str(param.device()), c10::str(moments_[p].first.device()));
     const torch::Tensor g = grad.contiguous();
-    adam_update(param.data_ptr<float>(), g.data_ptr<float>(), moments_[p].first.data_ptr<float>(),
-                moments_[p].second.data_ptr<float>(), param.numel(),
-                float(learning_rate(Param(p)) / bias1), float(std::sqrt(bias2)));
+    const auto update = param.is_cuda() ? device_adam_update : adam_update;
+    update(param.data_ptr<float>(), g.data_ptr<float>(), moments_[p].first.data_ptr<float>(),
+           moments_[p].second.data_ptr<float>(), param.numel(),
+           float(learning_rate(Param(p)) / bias1), float(std::sqrt(bias2)));
   }
   steps_ = step;
 }
@@ -82,8 +100,8 @@ void GaussianOptimizer::append_rows(int64_t count) {
   for (AdamMoments& m : moments_) {
     std::vector<int64_t> shape = m.first.sizes().vec();
     shape[0] = count;
-    m.first = torch::cat({m.first, torch::zeros(shape)});
-    m.second = torch::cat({m.second, torch::zeros(shape)});
+    m.first = torch::cat({m.first, torch::zeros(shape, m.first.options())});
+    m.second = torch::cat({m.second, torch::zeros(shape, m.second.options())});
   }
 }
 
@@ -91,6 +109,13 @@ void GaussianOptimizer::keep_rows(const torch::Tensor& keep) {
   for (AdamMoments& m : moments_) {
     m.first = m.first.index({keep}).contiguous();
     m.second = m.second.index({keep}).contiguous();
+  }
+}
+
+void GaussianOptimizer::to(torch::Device device) {
+  for (AdamMoments& m : moments_) {
+    m.first = m.first.to(device);
+    m.second = m.second.to(device);
   }
 }
 

@@ -51,6 +51,8 @@ class GaussianOptimizer {
   void append_rows(int64_t count);
   void keep_rows(const torch::Tensor& keep);
   void reset_moments(Param p);
+  // Moves the moments to `device`, where the model's parameters are.
+  void to(torch::Device device);
 
   // Exact state for resume. `load_state` throws Error when a moment's shape differs from its
   // parameter's in `model`.

@@ -42,6 +42,17 @@ torch::Tensor external_depth_loss(const raster::RenderOutput& render,
 
 }  // namespace
 
+FusionTargets FusionTargets::to(torch::Device device) const {
+  FusionTargets moved;
+  const auto move = [&](const torch::Tensor& t) { return t.defined() ? t.to(device) : t; };
+  moved.external_image = move(external_image);
+  moved.internal_image = move(internal_image);
+  moved.internal_share = move(internal_share);
+  moved.internal_depth = move(internal_depth);
+  moved.external_disparity = move(external_disparity);
+  return moved;
+}
+
 TextureGuidance parse_texture_guidance(const std::string& name) {
   for (int i = 0; i < 4; ++i)
     if (name == kGuidanceNames[i]) return TextureGuidance(i);

@@ -38,6 +38,9 @@ struct FusionTargets {
   torch::Tensor internal_share;      // (H, W) float: M for Masked, 0.5 / 0 / 1 for the others
   torch::Tensor internal_depth;      // (H, W) I_depth, expected camera z, 0 where nothing was drawn
   torch::Tensor external_disparity;  // (H, W) E_depth, relative inverse depth
+
+  // The same references on `device`, where the rendered views are.
+  FusionTargets to(torch::Device device) const;
 };
 
 // D(p) of the paper, (H, W), for diagnostics.

@@ -62,7 +62,7 @@ Vec3 up_direction(const std::vector<const Camera*>& cameras) {
       for (int j = 0; j < 3; ++j) m[i][j] += right[i] * right[j];
   }
   mean_up = normalized(mean_up);
-  const auto [values, vectors] = torch::linalg::eigh(moments, "L");  // ascending
+  const auto [values, vectors] = torch::linalg_eigh(moments, "L");  // ascending
   if (values[1].item<double>() < 1e-3 * double(cameras.size())) return mean_up;
   const auto v = vectors.accessor<double, 2>();
   const Vec3 up{v[0][0], v[1][0], v[2][0]};

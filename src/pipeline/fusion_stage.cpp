@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "core/device.hpp"
 #include "core/error.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
@@ -71,7 +72,9 @@ StageResult run_fusion_stage(FusionSetup setup, const train::TrainConfig& config
   trainer_setup.background = setup.background;
   trainer_setup.scene_extent = setup.scene_extent;
   trainer_setup.output_dir = dir;
-  auto targets = std::make_shared<const std::vector<loss::FusionTargets>>(std::move(setup.targets));
+  // The loss reads them where the trainer renders.
+  auto targets = std::make_shared<std::vector<loss::FusionTargets>>();
+  for (const loss::FusionTargets& t : setup.targets) targets->push_back(t.to(compute_device()));
   const loss::FusionWeights weights = setup.weights;
   trainer_setup.loss = [targets, weights](int view, const raster::RenderOutput& render) {
     return loss::fusion_loss(render, (*targets)[size_t(view)], weights).total;

@@ -38,11 +38,12 @@ RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
   const raster::RenderOutput out =
       raster::render(model.render_tensors(), raster::raster_camera<float>(camera), background);
   const torch::Tensor drawn = out.alpha > kMinAlphaForDepth;
-  RenderedView view;
-  view.image = out.image.clamp(0, 1);
+  RenderedView view;  // on the CPU, wherever the model renders
+  view.image = out.image.clamp(0, 1).cpu();
   view.depth = torch::where(drawn, out.depth / out.alpha.clamp_min(kMinAlphaForDepth),
-                            torch::zeros_like(out.depth));
-  view.alpha = out.alpha;
+                            torch::zeros_like(out.depth))
+                   .cpu();
+  view.alpha = out.alpha.cpu();
   return view;
 }
 

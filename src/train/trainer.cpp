@@ -14,6 +14,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "core/device.hpp"
 #include "core/error.hpp"
 #include "core/memory.hpp"
 #include "eval/metrics.hpp"
@@ -67,7 +68,8 @@ std::string tensor_bytes(const torch::Tensor& tensor) {
 }
 
 double psnr(const torch::Tensor& image, const torch::Tensor& target) {
-  const double mse = (image.clamp(0, 1) - target).square().mean().item<double>();
+  const torch::Tensor reference = target.to(image.device());  // views given from the CPU
+  const double mse = (image.clamp(0, 1) - reference).square().mean().item<double>();
   return eval::psnr_from_mse(std::max(mse, 1e-20));
 }
 
@@ -110,10 +112,13 @@ Trainer::Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianMode
   torch::manual_seed(config_.seed);
   view_rng_.seed(config_.seed);
   model_.active_sh_degree = std::min(model_.active_sh_degree, config_.max_sh_degree);
+  model_ = model_.to(device_);
+  for (std::vector<TrainView>* views : {&setup_.train_views, &setup_.test_views})
+    for (TrainView& view : *views) view.target = view.target.to(device_);
   gs::update_filter_3d(model_, train_cameras_);  // a start model's filter fits other cameras
   model_.antialiased = true;  // Mip-Splatting, whatever a starting .ply was drawn with
   optimizer_.emplace(model_, config_.learning_rates, setup_.scene_extent);
-  stats_ = gs::DensifyStats::zeros(model_.size());
+  stats_ = gs::DensifyStats::zeros(model_.size(), device_);
 }
 
 void Trainer::save_checkpoint() {
@@ -152,7 +157,10 @@ void Trainer::load_checkpoint() {
   require_same_cameras();  // before reading a checkpoint that may not fit these views
   gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}},
                               {"seconds", {}},   {"loss", {}},     {"test_psnr", {}}};
-  gs::load_training_state(path, model_, *optimizer_, stats_, &extras);
+  gs::load_training_state(path, model_, *optimizer_, stats_, &extras);  // onto the CPU
+  model_ = model_.to(device_);
+  optimizer_->to(device_);
+  stats_.to(device_);
   for (const char* required : {"iteration", "view_rng", "torch_rng"})
     if (!extras[required].defined())
       fail_file(path, fmt::format("not a training checkpoint of iesrgs train (no {})", required));
@@ -202,8 +210,9 @@ double Trainer::step(int64_t iteration) {
   double total = 0;
   for (int v : pick_views()) {
     const TrainView& view = setup_.train_views[size_t(v)];
-    raster::ViewspaceProbes probes{torch::zeros({model_.size(), 2}, torch::requires_grad()),
-                                   torch::zeros({model_.size(), 2}, torch::requires_grad())};
+    const auto probe_options = torch::TensorOptions().device(device_).requires_grad(true);
+    raster::ViewspaceProbes probes{torch::zeros({model_.size(), 2}, probe_options),
+                                   torch::zeros({model_.size(), 2}, probe_options)};
     const raster::RenderOutput render =
         raster::render(model_.render_tensors(), raster::raster_camera<float>(view.camera),
                        setup_.background, probes);

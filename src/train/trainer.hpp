@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "core/device.hpp"
 #include "gs/model.hpp"
 #include "io/camera.hpp"
 #include "raster/autograd.hpp"
@@ -68,6 +69,7 @@ class Trainer {
   // the loss or the parameters stop being finite; the last good checkpoint stays on disk.
   TrainSummary run();
 
+  // On the training device (core/device.hpp).
   const gs::GaussianModel& model() const { return model_; }
   std::filesystem::path checkpoint_path() const {
     return train::checkpoint_path(setup_.output_dir);
@@ -92,6 +94,7 @@ class Trainer {
   double training_seconds() const;
 
   TrainConfig config_;
+  torch::Device device_ = compute_device();  // holds the model, the targets and the optimizer
   TrainerSetup setup_;
   gs::GaussianModel model_;
   std::optional<gs::GaussianOptimizer> optimizer_;

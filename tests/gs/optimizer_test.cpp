@@ -9,6 +9,7 @@
 #include "gs/densify.hpp"
 #include "gs/random_model.hpp"
 #include "raster/raster_test_scene.hpp"
+#include "support/cuda_device.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -73,6 +74,26 @@ TEST(GaussianOptimizer, FusedStepMatchesTorchAdam) {
   }
   EXPECT_EQ(opt.steps_taken(), 6);
   EXPECT_NEAR(opt.learning_rate(Param::Means), 1.6e-6 * 2.5, 1e-18);
+}
+
+TEST(GaussianOptimizer, CudaStepMatchesCpu) {
+  IESRGS_SKIP_WITHOUT_CUDA();
+  torch::manual_seed(4);
+  GaussianModel cpu = random_model(500);
+  GaussianModel gpu = cpu.to(torch::kCUDA);
+  GaussianOptimizer cpu_opt(cpu, {}, 1.5), gpu_opt(gpu, {}, 1.5);
+  for (int step = 0; step < 3; ++step) {
+    set_random_grads(cpu);
+    for (int p = 0; p < kParamCount; ++p)
+      gpu.param(Param(p)).mutable_grad() = cpu.param(Param(p)).grad().to(torch::kCUDA);
+    cpu_opt.step(cpu);
+    gpu_opt.step(gpu);
+  }
+  for (int p = 0; p < kParamCount; ++p) {
+    ASSERT_TRUE(gpu.param(Param(p)).is_cuda());
+    EXPECT_LE((gpu.param(Param(p)).cpu() - cpu.param(Param(p))).abs().max().item<float>(), 1e-6)
+        << "group " << p;
+  }
 }
 
 TEST(GaussianOptimizer, StepNeedsEveryGradient) {
