@@ -23,7 +23,7 @@ using Op = LayersModel::Op;
 // Weight name as the manifest gives it ("<layer>/kernel") -> tensor of the manifest's shape.
 using Weights = std::map<std::string, torch::Tensor>;
 
-const json& member(const json& object, const std::string& key) {
+const json& member(const json& object, const char* key) {
   if (!object.is_object() || !object.contains(key))
     throw FormatError(fmt::format("missing '{}'", key));
   return object[key];
@@ -106,8 +106,8 @@ void parse_conv(const json& config, const Weights& weights, int64_t in_channels,
   const auto padding = member(config, "padding").get<std::string>();
   if (kernel_size.size() != 2 || (padding != "same" && padding != "valid"))
     throw FormatError("unsupported kernel size or padding");
-  const torch::Tensor& kernel = weight(weights, layer.name + "/kernel",
-                                       {kernel_size[0], kernel_size[1], in_channels, filters});
+  const torch::Tensor kernel = weight(weights, layer.name + "/kernel",
+                                      {kernel_size[0], kernel_size[1], in_channels, filters});
   layer.weight = kernel.permute({3, 2, 0, 1}).contiguous();  // HWIO -> OIHW
   if (member(config, "use_bias").get<bool>())
     layer.bias = weight(weights, layer.name + "/bias", {filters});

@@ -253,10 +253,10 @@ void expect_near(const Vec3& a, const Vec3& b) {
   EXPECT_NEAR(a.z, b.z, 1e-9);
 }
 
-const Camera& camera_named(const Scene& scene, const std::string& name) {
+const Camera& camera_named(const Scene& scene, const char* name) {
   for (const Camera& camera : scene.cameras)
     if (camera.name == name) return camera;
-  throw std::runtime_error("no camera " + name);
+  throw std::runtime_error(std::string("no camera ") + name);
 }
 
 TEST(Colmap, SceneCamerasFollowTheModel) {
