@@ -1,37 +1,84 @@
 #!/usr/bin/env bash
-# On a machine with an NVIDIA GPU, the CUDA toolkit, CMake and a C++ compiler: builds the
-# rasterizer kernels alone (no LibTorch), runs the CUDA tests, runs them again under
-# compute-sanitizer (memcheck, racecheck), then the benchmark at 800x800.
-#   scripts/cuda-check.sh [--deps DIR] [benchmark options, e.g. --cpu]
+# On a machine with an NVIDIA GPU, the CUDA toolkit, CMake and a C++ compiler: builds iesrgs with
+# its CUDA kernels and checks them.
+#   scripts/cuda-check.sh [--deps DIR] [--kernels-only] [--quick] [benchmark options, e.g. --cpu]
 #   scripts/cuda-check.sh --fetch-deps DIR
-# The build needs fmt and GoogleTest. Where the GPU machine has neither and cannot install them,
-# --fetch-deps downloads their Debian packages into DIR (on a Debian machine with apt), and
-# --deps DIR unpacks them into a temporary prefix for the build.
+# The full build links the LibTorch of the machine's PyTorch (python3 -c 'import torch'), runs the
+# main suite's GPU tests (rendering, SSIM, Adam and training through LibTorch, against the CPU),
+# then trains the same synthetic scene on the CPU and on the GPU and prints both results.
+# --kernels-only builds the kernels alone (no LibTorch) and ends with their benchmark at 800x800.
+# Both run the kernels' own tests, then again under compute-sanitizer (memcheck, racecheck) unless
+# --quick.
+# Where the GPU machine lacks the Debian libraries and cannot install them, --fetch-deps downloads
+# their packages into DIR (on a Debian machine with apt), and --deps DIR unpacks them into
+# /tmp/iesrgs-deps for the build and the binaries (their run path points there).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 if [ "${1:-}" = "--fetch-deps" ]; then
   mkdir -p "$2"
-  (cd "$2" && apt-get download libfmt-dev libfmt9 libgtest-dev libgmock-dev)
+  (cd "$2" && apt-get download libfmt-dev libfmt9 libgtest-dev libgmock-dev libspdlog-dev \
+    libspdlog1.10 nlohmann-json3-dev libcli11-dev libstb-dev libstb0 zlib1g-dev zlib1g \
+    libzstd-dev libzstd1)
   exit
 fi
-options=(-DIESRGS_KERNELS_ONLY=ON -DIESRGS_CUDA=ON -DCMAKE_BUILD_TYPE=Release)
+prefix_path=()
 if [ "${1:-}" = "--deps" ]; then
-  prefix=$(mktemp -d)
+  prefix=/tmp/iesrgs-deps
+  rm -rf "$prefix"
   for deb in "$2"/*.deb; do dpkg-deb -x "$deb" "$prefix"; done
-  options+=("-DCMAKE_PREFIX_PATH=$prefix/usr")
+  # Absolute links (libz.so -> /lib/...) must point into the prefix.
+  find "$prefix" -type l -lname '/*' | while read -r link; do
+    ln -sfn "$prefix$(readlink "$link")" "$link"
+  done
+  prefix_path+=("$prefix/usr")
   shift 2
 fi
+kernels_only=false
+if [ "${1:-}" = "--kernels-only" ]; then
+  kernels_only=true
+  shift
+fi
+sanitize=true
+if [ "${1:-}" = "--quick" ]; then
+  sanitize=false
+  shift
+fi
+
+options=(-DIESRGS_CUDA=ON -DCMAKE_BUILD_TYPE=Release -DIESRGS_BENCH=OFF)
+targets=(--target iesrgs_cuda_tests)
+if $kernels_only; then
+  options+=(-DIESRGS_KERNELS_ONLY=ON -DIESRGS_BENCH=ON)
+  targets+=(iesrgs_cuda_bench)
+else
+  prefix_path+=("$(python3 -c 'import torch; print(torch.utils.cmake_prefix_path)')")
+  targets+=(iesrgs iesrgs_tests)
+fi
+prefixes=$(IFS=';'; echo "${prefix_path[*]:-}")
 
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
-cmake -S . -B build-cuda "${options[@]}" >/dev/null
-cmake --build build-cuda -j "$(nproc)"
+cmake -S . -B build-cuda "${options[@]}" "-DCMAKE_PREFIX_PATH=$prefixes" >/dev/null
+cmake --build build-cuda -j "$(nproc)" "${targets[@]}"
 tests=build-cuda/iesrgs_cuda_tests
+[ -x "$tests" ] || tests=build-cuda/tests/iesrgs_cuda_tests
 status=0
 "$tests" || status=1
-compute-sanitizer --tool memcheck --error-exitcode 1 "$tests" || status=1
-# Racecheck is slow; the posed-camera scene runs both blend kernels over every kind of tile.
-compute-sanitizer --tool racecheck --error-exitcode 1 "$tests" \
-  --gtest_filter='*PosedCamera*:*OpaqueSplats*' || status=1
-build-cuda/bench/cuda/iesrgs_cuda_bench "$@"
+if ! $kernels_only; then
+  build-cuda/tests/iesrgs_tests --gtest_filter='*Cuda*' || status=1
+  # The same training on both devices: the GPU's test PSNR should match the CPU's.
+  scene=$(mktemp -d)
+  build-cuda/iesrgs synth -o "$scene/data" --size 128 --views 40 --test-views 8 >/dev/null
+  for device in cpu cuda; do
+    build-cuda/iesrgs train "$scene/data" -o "$scene/$device" --device "$device" --preset fast \
+      --iterations 2000 | grep -E '^(device|done)' || status=1
+  done
+  rm -rf "$scene"
+fi
+if $sanitize; then
+  compute-sanitizer --tool memcheck --error-exitcode 1 "$tests" || status=1
+  # Racecheck is slow; the posed-camera scene runs both blend kernels over every kind of tile.
+  compute-sanitizer --tool racecheck --error-exitcode 1 "$tests" \
+    --gtest_filter='*PosedCamera*:*OpaqueSplats*' || status=1
+fi
+if $kernels_only; then build-cuda/bench/cuda/iesrgs_cuda_bench "$@"; fi
 exit $status
