@@ -8,9 +8,10 @@ namespace iesrgs::cli {
 
 void add_device_option(CLI::App& command, std::string& device) {
   command
-      .add_option("--device", device,
-                  "Train on the cpu, on a cuda GPU, or auto: the GPU when this build and machine "
-                  "have one")
+      .add_option(
+          "--device", device,
+          "Run on the cpu, on a cuda GPU, or auto: the GPU when this build and machine have "
+          "one")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
       ->capture_default_str();
 }

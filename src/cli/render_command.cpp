@@ -6,8 +6,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/device_option.hpp"
 #include "cli/scene_options.hpp"
 #include "cli/validators.hpp"
+#include "core/device.hpp"
 #include "core/error.hpp"
 #include "gs/model.hpp"
 #include "io/atomic_file.hpp"
@@ -28,10 +30,13 @@ struct RenderArgs {
   std::string path;
   int frames = 120;
   std::string rasterize_mode = "auto";
+  std::string device = "auto";
 };
 
 void run_render(const RenderArgs& args) {
-  gs::GaussianModel model = gs::model_from_splat_cloud(read_model(model_file(args.model)));
+  use_device(args.device);
+  gs::GaussianModel model =
+      gs::model_from_splat_cloud(read_model(model_file(args.model))).to(compute_device());
   if (args.rasterize_mode != "auto") model.antialiased = args.rasterize_mode == "antialiased";
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   const std::string what = args.path.empty() ? args.split : args.path + " path";
@@ -97,6 +102,7 @@ void add_render_command(CLI::App& app) {
                    "the model's own (antialiased with a filter_3D or an .spz flagged so)")
       ->check(CLI::IsMember({"auto", "antialiased", "classic"}))
       ->capture_default_str();
+  add_device_option(*command, args->device);
   command->callback([args] { run_render(*args); });
 }
 
