@@ -5,7 +5,8 @@
 #   scripts/cuda-check.sh --fetch-deps DIR
 # The full build links the LibTorch of the machine's PyTorch (python3 -c 'import torch'), runs the
 # main suite's GPU tests (rendering, SSIM, Adam and training through LibTorch, against the CPU),
-# then trains the same synthetic scene on the CPU and on the GPU and prints both results.
+# trains the same synthetic scene on the CPU and on the GPU and prints both results, then runs the
+# whole suite.
 # --kernels-only builds the kernels alone (no LibTorch) and ends with their benchmark at 800x800.
 # Both run the kernels' own tests, then again under compute-sanitizer (memcheck, racecheck) unless
 # --quick.
@@ -70,9 +71,11 @@ if ! $kernels_only; then
   build-cuda/iesrgs synth -o "$scene/data" --size 128 --views 40 --test-views 8 >/dev/null
   for device in cpu cuda; do
     build-cuda/iesrgs train "$scene/data" -o "$scene/$device" --device "$device" --preset fast \
-      --iterations 2000 | grep -E '^(device|done)' || status=1
+      --iterations 1000 | grep -E '^(device|done)' || status=1
   done
   rm -rf "$scene"
+  # The whole suite, whose command-line tests train and render with --device auto: on the GPU.
+  ctest --test-dir build-cuda --output-on-failure -j "$(nproc)" || status=1
 fi
 if $sanitize; then
   compute-sanitizer --tool memcheck --error-exitcode 1 "$tests" || status=1
