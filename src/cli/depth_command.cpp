@@ -6,6 +6,8 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/device_option.hpp"
+#include "core/device.hpp"
 #include "core/error.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
@@ -21,20 +23,23 @@ struct DepthArgs {
   std::string model = "depth-anything-v2";
   std::string weights, in, out;
   float background = 0.f;
+  std::string device = "auto";
 };
 
 void run_depth(const DepthArgs& args) {
   using priors::depth::DepthJob;
+  use_device(args.device);
   const std::vector<DepthJob> jobs = priors::depth::plan_depth_jobs(args.in, args.out);
   const std::unique_ptr<priors::depth::DepthNet> net =
-      priors::depth::make_depth_net(args.model, args.weights);
+      priors::depth::make_depth_net(args.model, args.weights, compute_device());
   if (!net) fail("depth: model '{}' predicts nothing, so there is nothing to write", args.model);
   const float background[3] = {args.background, args.background, args.background};
   const auto first = std::chrono::steady_clock::now();
   for (size_t i = 0; i < jobs.size(); ++i) {
     const auto start = std::chrono::steady_clock::now();
     const Image rgb = composite_rgb(read_image8(jobs[i].image), background);
-    priors::depth::write_depth_outputs(net->predict(to_tensor(rgb)), jobs[i]);
+    priors::depth::write_depth_outputs(net->predict(to_tensor(rgb).to(compute_device())).cpu(),
+                                       jobs[i]);
     const auto now = std::chrono::steady_clock::now();
     const std::chrono::duration<double> elapsed = now - start, total = now - first;
     fmt::print("[{}/{}] {} -> {} ({}x{}, {:.2f} s, ETA {})\n", i + 1, jobs.size(),
@@ -70,6 +75,7 @@ void add_depth_command(CLI::App& app) {
       ->add_option("OUT", args->out,
                    "For an image: the .npy to write; for a folder: the folder to write into")
       ->required();
+  add_device_option(*command, args->device);
   command->callback([args] { run_depth(*args); });
 }
 

@@ -1,6 +1,6 @@
 #pragma once
-// --device on the commands that train or render: where the model, its images and the kernels
-// run.
+// --device on the commands that compute (train, render, the networks): where the tensors and the
+// kernels run.
 #include <CLI/CLI.hpp>
 
 #include <string>

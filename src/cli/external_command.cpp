@@ -1,6 +1,7 @@
 // iesrgs external: stage 1 of IE-SRGS alone (2D super-resolution and monocular depth of every
 // training view), cached and resumable.
 #include "cli/commands.hpp"
+#include "cli/device_option.hpp"
 #include "cli/external_options.hpp"
 #include "cli/scene_options.hpp"
 #include "pipeline/external_stage.hpp"
@@ -13,9 +14,11 @@ struct ExternalArgs {
   SceneArgs scene;
   std::string output;
   pipeline::ExternalOptions options;
+  std::string device = "auto";
 };
 
 void run_external(const ExternalArgs& args) {
+  use_device(args.device);
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   ViewImages images(scene);
   pipeline::ExternalOptions options = args.options;
@@ -33,6 +36,7 @@ void add_external_command(CLI::App& app) {
   command->add_option("-o,--output", args->output, "Output folder (image/, depth/)")->required();
   command->add_option("--scale", args->options.scale, "Upscaling factor s")->capture_default_str();
   add_external_options(*command, args->options);
+  add_device_option(*command, args->device);
   command->callback([args] { run_external(*args); });
 }
 

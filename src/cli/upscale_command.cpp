@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/device_option.hpp"
 #include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "core/paths.hpp"
@@ -35,6 +36,7 @@ struct UpscaleArgs {
   priors::sr::TileOptions tiles{256, 32};
   float background = 1.f;
   fs::path input, output;
+  std::string device = "auto";
 };
 
 struct Job {
@@ -71,6 +73,7 @@ std::pair<int, int> upscale_one(SrNet& net, const UpscaleArgs& args, const Job& 
 }
 
 void run(const UpscaleArgs& args) {
+  use_device(args.device);
   const std::vector<Job> jobs = jobs_for(args.input, args.output);
   const std::unique_ptr<SrNet> net = priors::sr::make_sr_net(args.model, args.weights, args.scale);
   const auto first = std::chrono::steady_clock::now();
@@ -121,6 +124,7 @@ void add_upscale_command(CLI::App& app) {
       ->check(CLI::Range(0.f, 1.f));
   command->add_option("input", args->input, "Image or folder of images")->required();
   command->add_option("output", args->output, "PNG file, or folder for a folder input")->required();
+  add_device_option(*command, args->device);
   command->callback([args] { run(*args); });
 }
 

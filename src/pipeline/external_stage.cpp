@@ -6,6 +6,7 @@
 #include <chrono>
 #include <nlohmann/json.hpp>
 
+#include "core/device.hpp"
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
@@ -90,7 +91,8 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
     }
     if (!loaded) {
       sr = priors::sr::make_sr_net(options.sr_model, options.sr_weights, options.scale);
-      depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights);
+      depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights,
+                                            compute_device());
       loaded = true;
     }
     // Forget the view's old entry first: a run killed between the writes below must not leave
@@ -103,7 +105,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
       // Depth of E_image as the model saw it: the 8-bit image written above.
       const torch::Tensor seen = to_tensor(to_float(read_image8(view.image)));
       priors::depth::write_depth_outputs(
-          depth->predict(seen),
+          depth->predict(seen.to(compute_device())).cpu(),
           {view.image, view.depth, dir / "depth" / (camera.name + "_preview.png")});
     }
     record[camera.name] = fingerprint;

@@ -59,10 +59,12 @@ class NetworkSr final : public SrNet {
         pad_x == 0 && pad_y == 0
             ? rgb
             : F::pad(rgb, F::PadFuncOptions({0, pad_x, 0, pad_y}).mode(torch::kReplicate));
-    return net_->forward(input.contiguous(torch::MemoryFormat::ChannelsLast))
-        .narrow(2, 0, height * scale_)
-        .narrow(3, 0, width * scale_)
-        .contiguous();
+    return on_compute_device(*net_, input, [&](const torch::Tensor& x) {
+      return net_->forward(x.contiguous(torch::MemoryFormat::ChannelsLast))
+          .narrow(2, 0, height * scale_)
+          .narrow(3, 0, width * scale_)
+          .contiguous();
+    });
   }
 
  private:

@@ -7,6 +7,8 @@
 #include <memory>
 #include <string>
 
+#include "core/device.hpp"
+
 namespace iesrgs::priors::sr {
 
 class SrNet {
@@ -15,10 +17,21 @@ class SrNet {
   virtual std::string name() const = 0;
   virtual int scale() const = 0;
   // RGB in [0, 1], shape (1, 3, H, W) -> (1, 3, scale * H, scale * W), under
-  // torch::NoGradGuard. Any padding the network needs (e.g. to a window
-  // multiple) happens inside and is cropped off again.
+  // torch::NoGradGuard; CPU tensors in and out, the networks computed on the compute device. Any
+  // padding the network needs (e.g. to a window multiple) happens inside and is cropped off again.
   virtual torch::Tensor upscale(const torch::Tensor& rgb) = 0;
 };
+
+// forward(input) on the process's compute device (core/device.hpp), with `module` moved there
+// (a no-op once it is): the input goes there, the result comes back to the CPU, where the
+// callers keep their images.
+template <class Forward>
+torch::Tensor on_compute_device(torch::nn::Module& module, const torch::Tensor& input,
+                                Forward&& forward) {
+  const torch::Device device = compute_device();
+  module.to(device);
+  return forward(input.to(device)).to(torch::kCPU);
+}
 
 // Builds the backend `model` (bicubic, safmn, imdn, pan, swinir, esrgan-slim,
 // esrgan-medium, esrgan-thick) for `scale`, loading `weights` when the model

@@ -435,11 +435,11 @@ torch::Tensor SwinIRUpscaler::upscale(const torch::Tensor& rgb) {
     fail("SwinIR: expected an RGB batch of shape (B, 3, H, W), got {}", c10::str(rgb.sizes()));
   torch::NoGradGuard no_grad;
   const int64_t scale = net_->config().scale;
-  const torch::Tensor padded =
-      mirror_pad_past_window(rgb.to(torch::kFloat), net_->config().window_size);
-  return net_->forward(padded)
-      .index({Slice(), Slice(), Slice(0, scale * rgb.size(2)), Slice(0, scale * rgb.size(3))})
-      .contiguous();
+  return on_compute_device(*net_, rgb.to(torch::kFloat), [&](const torch::Tensor& x) {
+    return net_->forward(mirror_pad_past_window(x, net_->config().window_size))
+        .index({Slice(), Slice(), Slice(0, scale * rgb.size(2)), Slice(0, scale * rgb.size(3))})
+        .contiguous();
+  });
 }
 
 std::unique_ptr<SrNet> make_swinir(const std::filesystem::path& weights, int scale) {
