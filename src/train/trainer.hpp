@@ -2,6 +2,7 @@
 // The Gaussian-splatting training loop every stage uses: Mip-Splatting (3D filter, 2D mip
 // filter) with 3DGS's densification and schedules, and MVGS's multi-view regulation (K distinct
 // views per iteration, losses summed, one optimizer step, densification statistics from all K).
+// It trains on the compute device (core/device.hpp) that is current when it is built.
 #include <torch/types.h>
 
 #include <array>
