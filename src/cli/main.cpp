@@ -1,4 +1,5 @@
 // iesrgs: low-resolution multi-view captures in, high-resolution 3D Gaussian Splatting out.
+#include <fmt/core.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
@@ -6,6 +7,7 @@
 #include <cstdio>
 
 #include "cli/commands.hpp"
+#include "core/device.hpp"
 #include "core/torch_error.hpp"
 
 int main(int argc, char** argv) {
@@ -14,7 +16,12 @@ int main(int argc, char** argv) {
   // uses for our own kernels (OMP_NUM_THREADS still limits both).
   torch::set_num_threads(omp_get_max_threads());
   app.require_subcommand(1);
-  app.set_version_flag("--version", "iesrgs 0.1.0");
+  // Which device --device auto takes here, so a user sees at once whether the GPU is usable.
+  app.set_version_flag("--version", [] {
+    return fmt::format("iesrgs 0.1.0\nCUDA kernels: {}\n--device auto: {}",
+                       iesrgs::cuda_kernels_built() ? "built" : "not built",
+                       iesrgs::describe_device(iesrgs::parse_device("auto")));
+  });
   app.add_flag_callback(
       "-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); }, "Print debug messages");
   iesrgs::cli::add_synth_command(app);

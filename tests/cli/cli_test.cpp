@@ -29,6 +29,13 @@ TEST(Cli, InfoHelpExplainsTheOptions) {
   EXPECT_TRUE(contains(run.output, "--downscale")) << run.output;
 }
 
+TEST(Cli, VersionSaysWhichDeviceAutoTakes) {
+  const CliRun run = iesrgs("--version");
+  EXPECT_EQ(run.status, 0);
+  EXPECT_TRUE(contains(run.output, "iesrgs 0.1.0\nCUDA kernels: ")) << run.output;
+  EXPECT_TRUE(contains(run.output, "--device auto: ")) << run.output;
+}
+
 TEST(Cli, MissingSceneIsOneLineNamingThePath) {
   TempDir dir;
   const CliRun run = iesrgs("info " + (dir / "nowhere").string());
