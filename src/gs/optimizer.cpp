@@ -24,16 +24,16 @@ void adam_update(float* param, const float* grad, float* first, float* second, i
     adam_update_value(param[i], grad[i], first[i], second[i], step_size, bias2_sqrt);
 }
 
+#ifdef IESRGS_WITH_CUDA
 void device_adam_update(float* param, const float* grad, float* first, float* second, int64_t count,
                         float step_size, float bias2_sqrt) {
-#ifdef IESRGS_WITH_CUDA
   cuda::adam_update(param, grad, first, second, count, step_size, bias2_sqrt);
-#else
-  (void)param, (void)grad, (void)first, (void)second, (void)count, (void)step_size,
-      (void)bias2_sqrt;
-  fail("optimizer step: this build has no CUDA kernels");
-#endif
 }
+#else
+void device_adam_update(float*, const float*, float*, float*, int64_t, float, float) {
+  fail("optimizer step: this build has no CUDA kernels");
+}
+#endif
 
 }  // namespace
 

@@ -68,9 +68,14 @@ cuda::Ssim& device_ssim() {
 }
 #endif
 
-void require_float_on_gpu(const at::Tensor& x, const char* what) {
-  if (x.is_cuda() && x.scalar_type() != at::kFloat)
-    fail("{}: CUDA tensors must be float32, not {}", what, c10::toString(x.scalar_type()));
+// SSIM's kernels: the CPU ones, and in a CUDA build the CUDA ones for float32 tensors on a GPU.
+void require_ssim_kernel_for(const at::Tensor& x, const char* what) {
+  if (x.device().is_cpu()) return;
+#ifdef IESRGS_WITH_CUDA
+  if (x.is_cuda() && x.scalar_type() == at::kFloat) return;
+#endif
+  fail("{}: this build has no kernel for {} tensors on {}", what, c10::toString(x.scalar_type()),
+       c10::str(x.device()));
 }
 
 class SsimFunction : public torch::autograd::Function<SsimFunction> {
@@ -179,7 +184,7 @@ class GuidedTextureFunction : public torch::autograd::Function<GuidedTextureFunc
 
 SsimTensors ssim_autograd(const at::Tensor& x, const at::Tensor& y) {
   check_pair("ssim", x, y);
-  require_float_on_gpu(x, "ssim");
+  require_ssim_kernel_for(x, "ssim");
   const variable_list out = SsimFunction::apply(x, y);
   return {out[0], out[1]};
 }
@@ -202,8 +207,10 @@ at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& i
       internal_share.scalar_type() != render.scalar_type())
     fail("guided texture: the internal share must be a {} map of the render's dtype",
          c10::str(expected));
-  if (render.is_cuda())
+  if (!render.device().is_cpu()) {  // the kernel reads host memory
+    require_ssim_kernel_for(render, "guided texture");
     return guided_texture_from_ops(render, internal, external, internal_share, dssim_weight);
+  }
   return GuidedTextureFunction::apply(render, internal.defined() ? internal : at::empty({0}),
                                       external, internal_share, dssim_weight);
 }

@@ -169,6 +169,17 @@ TEST(SsimAutograd, BadInputsAreErrors) {
             "ssim: target dtype Double differs from Float");
   EXPECT_EQ(testing::error_message([&] { ssim_autograd(image.to(at::kInt), image.to(at::kInt)); }),
             "ssim: dtype Int is not float32 or float64");
+  // A device with no kernel, rather than the CPU kernel reading memory that is not the host's.
+  const at::Tensor elsewhere = torch::empty({3, 8, 9}, torch::Device(torch::kMeta));
+  EXPECT_EQ(testing::error_message([&] { ssim_autograd(elsewhere, elsewhere); }),
+            "ssim: this build has no kernel for Float tensors on meta");
+  EXPECT_EQ(testing::error_message([&] {
+              guided_texture_autograd(elsewhere, {}, elsewhere,
+                                      torch::zeros({8, 9}, torch::Device(torch::kMeta)), 0.2);
+            }),
+            "guided texture: this build has no kernel for Float tensors on meta");
+  EXPECT_EQ(testing::error_message([&] { ssim_autograd(image, image.to(torch::kMeta)); }),
+            "ssim: the target is on meta, the value on cpu");
 }
 
 TEST(PearsonAutograd, MatchesTorchOpsWithAndWithoutMask) {

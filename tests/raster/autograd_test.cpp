@@ -165,6 +165,15 @@ TEST(RasterAutograd, RejectsWrongShapes) {
   EXPECT_THROW(render(g, raster_camera<float>(cam), {0, 0, 0}), Error);
   g.sh = torch::zeros({4, 16, 3}, torch::kFloat64);
   EXPECT_THROW(render(g, raster_camera<float>(cam), {0, 0, 0}), Error);
+  // Tensors on a device this build has no rasterizer for.
+  for (torch::Tensor* t : {&g.means, &g.log_scales, &g.quats, &g.opacity_logits, &g.sh})
+    *t = torch::zeros(t->sizes(), torch::Device(torch::kMeta));
+  try {
+    render(g, raster_camera<float>(cam), {0, 0, 0});
+    ADD_FAILURE() << "rendered tensors on the meta device";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "render: this build has no rasterizer for tensors on meta");
+  }
 }
 
 }  // namespace
