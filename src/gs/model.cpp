@@ -89,17 +89,15 @@ raster::GaussianTensors GaussianModel::render_tensors() const {
 }
 
 GaussianModel GaussianModel::clone() const {
-  GaussianModel copy = *this;
-  for (int p = 0; p < kParamCount; ++p) copy.set_param(Param(p), param(Param(p)));
-  if (filter_3d.defined()) copy.filter_3d = filter_3d.clone();
-  return copy;
+  return to(means.device());
 }
 
 GaussianModel GaussianModel::to(torch::Device device) const {
-  GaussianModel moved = *this;
-  for (int p = 0; p < kParamCount; ++p) moved.set_param(Param(p), param(Param(p)).to(device));
-  if (filter_3d.defined()) moved.filter_3d = filter_3d.to(device);
-  return moved;
+  GaussianModel copy = *this;
+  // set_param copies, so the same device shares nothing either.
+  for (int p = 0; p < kParamCount; ++p) copy.set_param(Param(p), param(Param(p)).to(device));
+  if (filter_3d.defined()) copy.filter_3d = filter_3d.to(device).clone();
+  return copy;
 }
 
 void GaussianModel::set_param(Param p, const torch::Tensor& value) {

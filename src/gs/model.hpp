@@ -40,7 +40,7 @@ struct GaussianModel {
   // A copy that shares no storage with this model. Copying the struct shares the tensors, and
   // the optimizer updates them in place, so training such a copy would change this model too.
   GaussianModel clone() const;
-  // A copy on `device` (the CPU, or a GPU to train there), sharing no storage with this model.
+  // clone() on `device` (the CPU, or a GPU to train there).
   GaussianModel to(torch::Device device) const;
 
   // The optimized tensor becomes a contiguous copy of `value`, a fresh leaf that requires grad.

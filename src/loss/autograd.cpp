@@ -57,7 +57,7 @@ void check_pair(const char* what, const at::Tensor& value, const at::Tensor& tar
 // Pearson has no CUDA kernel: device tensors run the CPU one on host copies, two image-sized
 // transfers per view.
 at::Tensor on_host(const at::Tensor& t) {
-  return t.device().is_cpu() ? t.contiguous() : t.to(at::kCPU).contiguous();
+  return t.to(at::kCPU).contiguous();
 }
 
 #ifdef IESRGS_WITH_CUDA

@@ -84,6 +84,11 @@ bool all_finite(const gs::GaussianModel& model) {
 // random points).
 constexpr int64_t kBytesPerGaussian = 1400;
 
+// The trainer's own model on `device`: copied only when it is elsewhere.
+void place_on(gs::GaussianModel& model, torch::Device device) {
+  if (model.means.device() != device) model = model.to(device);
+}
+
 gs::DensifyOptions densify_options(const TrainConfig& c, int64_t iteration) {
   gs::DensifyOptions options;
   options.grad_threshold = c.grad_threshold;
@@ -112,7 +117,7 @@ Trainer::Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianMode
   torch::manual_seed(config_.seed);
   view_rng_.seed(config_.seed);
   model_.active_sh_degree = std::min(model_.active_sh_degree, config_.max_sh_degree);
-  model_ = model_.to(device_);
+  place_on(model_, device_);
   for (std::vector<TrainView>* views : {&setup_.train_views, &setup_.test_views})
     for (TrainView& view : *views) view.target = view.target.to(device_);
   gs::update_filter_3d(model_, train_cameras_);  // a start model's filter fits other cameras
@@ -158,7 +163,7 @@ void Trainer::load_checkpoint() {
   gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}},
                               {"seconds", {}},   {"loss", {}},     {"test_psnr", {}}};
   gs::load_training_state(path, model_, *optimizer_, stats_, &extras);  // onto the CPU
-  model_ = model_.to(device_);
+  place_on(model_, device_);
   optimizer_->to(device_);
   stats_.to(device_);
   for (const char* required : {"iteration", "view_rng", "torch_rng"})
