@@ -1,7 +1,6 @@
 // iesrgs depth: monocular relative depth (inverse depth) for one image or a folder of them.
 #include <fmt/format.h>
 
-#include <chrono>
 #include <memory>
 #include <string>
 
@@ -34,17 +33,13 @@ void run_depth(const DepthArgs& args) {
       priors::depth::make_depth_net(args.model, args.weights, compute_device());
   if (!net) fail("depth: model '{}' predicts nothing, so there is nothing to write", args.model);
   const float background[3] = {args.background, args.background, args.background};
-  const auto first = std::chrono::steady_clock::now();
+  train::ItemPace pace(jobs.size());
   for (size_t i = 0; i < jobs.size(); ++i) {
-    const auto start = std::chrono::steady_clock::now();
     const Image rgb = composite_rgb(read_image8(jobs[i].image), background);
     priors::depth::write_depth_outputs(net->predict(to_tensor(rgb).to(compute_device())).cpu(),
                                        jobs[i]);
-    const auto now = std::chrono::steady_clock::now();
-    const std::chrono::duration<double> elapsed = now - start, total = now - first;
-    fmt::print("[{}/{}] {} -> {} ({}x{}, {:.2f} s, ETA {})\n", i + 1, jobs.size(),
-               jobs[i].image.string(), jobs[i].npy.string(), rgb.width, rgb.height, elapsed.count(),
-               train::format_eta(i + 1, jobs.size(), total.count()));
+    fmt::print("[{}/{}] {} -> {} ({}x{}, {})\n", i + 1, jobs.size(), jobs[i].image.string(),
+               jobs[i].npy.string(), rgb.width, rgb.height, pace.finished(i + 1));
   }
 }
 

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -76,16 +75,12 @@ void run(const UpscaleArgs& args) {
   use_device(args.device);
   const std::vector<Job> jobs = jobs_for(args.input, args.output);
   const std::unique_ptr<SrNet> net = priors::sr::make_sr_net(args.model, args.weights, args.scale);
-  const auto first = std::chrono::steady_clock::now();
+  train::ItemPace pace(jobs.size());
   for (size_t i = 0; i < jobs.size(); ++i) {
-    const auto start = std::chrono::steady_clock::now();
     const auto [width, height] = upscale_one(*net, args, jobs[i]);
-    const auto now = std::chrono::steady_clock::now();
-    const std::chrono::duration<double> seconds = now - start, total = now - first;
-    fmt::print("[{}/{}] {} {}x{} -> {} {}x{} ({:.2f} s, ETA {})\n", i + 1, jobs.size(),
-               jobs[i].input.string(), width, height, jobs[i].output.string(), width * args.scale,
-               height * args.scale, seconds.count(),
-               train::format_eta(i + 1, jobs.size(), total.count()));
+    fmt::print("[{}/{}] {} {}x{} -> {} {}x{} ({})\n", i + 1, jobs.size(), jobs[i].input.string(),
+               width, height, jobs[i].output.string(), width * args.scale, height * args.scale,
+               pace.finished(i + 1));
     std::fflush(stdout);
   }
 }

@@ -61,6 +61,15 @@ std::string format_eta(size_t done, size_t total, double seconds) {
   return format_duration(seconds / double(done) * double(total - std::min(done, total)));
 }
 
+ItemPace::ItemPace(size_t total) : total_(total), first_(Clock::now()), last_(first_) {}
+
+std::string ItemPace::finished(size_t done) {
+  const Clock::time_point now = Clock::now();
+  const std::chrono::duration<double> item = now - last_, all = now - first_;
+  last_ = now;
+  return fmt::format("{:.2f} s, ETA {}", item.count(), format_eta(done, total_, all.count()));
+}
+
 std::string format_duration(double seconds) {
   const int64_t total = std::llround(std::max(0.0, seconds));
   const int64_t h = total / 3600, m = total / 60 % 60, s = total % 60;
