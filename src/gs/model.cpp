@@ -94,9 +94,13 @@ GaussianModel GaussianModel::clone() const {
 
 GaussianModel GaussianModel::to(torch::Device device) const {
   GaussianModel copy = *this;
-  // set_param copies, so the same device shares nothing either.
-  for (int p = 0; p < kParamCount; ++p) copy.set_param(Param(p), param(Param(p)).to(device));
-  if (filter_3d.defined()) copy.filter_3d = filter_3d.to(device).clone();
+  // One copy each, also on the same device, so that the two models share nothing.
+  const auto copied = [device](const torch::Tensor& t) {
+    return t.detach().to(t.options().device(device), /*non_blocking=*/false, /*copy=*/true);
+  };
+  for (int p = 0; p < kParamCount; ++p)
+    copy.param(Param(p)) = copied(param(Param(p))).contiguous().requires_grad_(true);
+  if (filter_3d.defined()) copy.filter_3d = copied(filter_3d);
   return copy;
 }
 
