@@ -4,6 +4,17 @@
 
 namespace iesrgs {
 
+Vec3 solve(const Mat3& a, const Vec3& b) {
+  const double det = a.determinant();
+  double x[3];
+  for (int column = 0; column < 3; ++column) {
+    Mat3 replaced = a;
+    for (int row = 0; row < 3; ++row) replaced(row, column) = b[row];
+    x[column] = replaced.determinant() / det;
+  }
+  return {x[0], x[1], x[2]};
+}
+
 double median(std::vector<double> values) {
   if (values.empty()) return 0;
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());

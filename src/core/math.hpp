@@ -55,6 +55,10 @@ struct Mat3 {
         r(i, j) = (*this)(i, 0) * o(0, j) + (*this)(i, 1) * o(1, j) + (*this)(i, 2) * o(2, j);
     return r;
   }
+  double determinant() const {
+    return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+           m[2] * (m[3] * m[7] - m[4] * m[6]);
+  }
   Mat3 transposed() const {
     Mat3 r;
     for (int i = 0; i < 3; ++i)
@@ -62,6 +66,9 @@ struct Mat3 {
     return r;
   }
 };
+
+// x with a * x = b, by Cramer's rule; the caller checks that `a` is well conditioned.
+Vec3 solve(const Mat3& a, const Vec3& b);
 
 // The middle value (the upper one of the two middle values for an even count); 0 when empty.
 double median(std::vector<double> values);

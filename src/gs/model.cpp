@@ -135,11 +135,13 @@ GaussianModel model_from_point_cloud(const PointCloud& cloud) {
   return model_from_points(positions, colors);
 }
 
-GaussianModel model_from_random_box(int count, float half_extent, uint64_t seed) {
+GaussianModel model_from_random_box(int count, float half_extent, uint64_t seed,
+                                    const Vec3& center) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<float> unit(0.f, 1.f);
   std::vector<float> positions(3 * size_t(count)), dc(3 * size_t(count));
-  for (float& p : positions) p = (2 * unit(rng) - 1) * half_extent;
+  for (size_t i = 0; i < positions.size(); ++i)
+    positions[i] = float(center[int(i % 3)]) + (2 * unit(rng) - 1) * half_extent;
   for (float& c : dc) c = unit(rng) / 255.f;
   return model_from_positions_and_dc(positions, dc);
 }

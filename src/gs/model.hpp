@@ -57,10 +57,11 @@ GaussianModel model_from_points(const std::vector<float>& positions,
 // From SfM points (colors 0..255).
 GaussianModel model_from_point_cloud(const PointCloud& cloud);
 
-// 3DGS's NeRF-Synthetic start: `count` points uniform in [-half_extent, half_extent]^3 whose SH
-// DC is uniform in [0, 1/255), i.e. near-gray colors, exactly as its random init produces.
-GaussianModel model_from_random_box(int count = 100000, float half_extent = 1.3f,
-                                    uint64_t seed = 0);
+// 3DGS's NeRF-Synthetic start: `count` points uniform in the cube of half-size `half_extent`
+// around `center` (3DGS: 1.3 around the origin) whose SH DC is uniform in [0, 1/255), i.e.
+// near-gray colors, exactly as its random init produces.
+GaussianModel model_from_random_box(int count = 100000, float half_extent = 1.3f, uint64_t seed = 0,
+                                    const Vec3& center = {});
 
 // Recomputes the Mip-Splatting 3D filter from the training cameras.
 void update_filter_3d(GaussianModel& model, const std::vector<Camera>& cameras);

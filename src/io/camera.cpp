@@ -35,6 +35,24 @@ Camera Camera::scaled(double scale) const {
   return c;
 }
 
+std::optional<Vec3> focus_point(const std::vector<const Camera*>& cameras) {
+  if (cameras.size() < 2) return std::nullopt;
+  // Minimizes sum_i |(I - d_i d_i^T)(p - c_i)|^2 over p: the normal equations below.
+  Mat3 a;
+  a.m.fill(0);
+  Vec3 b;
+  for (const Camera* camera : cameras) {
+    const Vec3 d = camera->axis(2);
+    Mat3 projector;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) projector(i, j) = (i == j) - d[i] * d[j];
+    for (int k = 0; k < 9; ++k) a.m[k] += projector.m[k];
+    b = b + projector * camera->center();
+  }
+  if (std::abs(a.determinant()) < 1e-6 * std::pow(double(cameras.size()), 3)) return std::nullopt;
+  return solve(a, b);
+}
+
 void opengl_c2w_to_opencv_w2c(const double c2w[4][4], Mat3& rotation, Vec3& translation) {
   // Flip the camera's y and z axes (OpenGL -> OpenCV), then invert the rigid transform.
   Mat3 r_c2w;

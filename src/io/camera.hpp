@@ -2,7 +2,9 @@
 // A posed pinhole camera in the OpenCV convention used everywhere inside iesrgs:
 // x right, y down, z forward; world-to-camera p_cam = R * p_world + t.
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "core/math.hpp"
 
@@ -53,9 +55,15 @@ struct Camera {
   Distortion distortion;  // of the stored image; loading undistorts it to a pinhole image
 
   Vec3 center() const { return -(rotation.transposed() * translation); }
+  // One of the camera's axes in world coordinates (0 right, 1 down, 2 forward).
+  Vec3 axis(int i) const { return {rotation(i, 0), rotation(i, 1), rotation(i, 2)}; }
   // Same pose, `scale` times the resolution (rendering at s x is just another camera).
   Camera scaled(double scale) const;
 };
+
+// The point nearest to every camera's optical axis (least squares): what a capture looks at.
+// None for fewer than two cameras, and when the axes are parallel (a rig of parallel cameras).
+std::optional<Vec3> focus_point(const std::vector<const Camera*>& cameras);
 
 // World-to-camera (OpenCV) from a camera-to-world matrix in the OpenGL / NeRF convention
 // (x right, y up, z backward), as stored by NeRF-Synthetic and nerfstudio transforms.json.

@@ -16,30 +16,6 @@ namespace {
 // the arc they cover instead of the whole ellipse, which would look at the scene from behind.
 constexpr double kLargestGapForAFullTurn = kPi / 2;
 
-// A camera's axis in world coordinates: a row of its world-to-camera rotation (OpenCV: 0 right,
-// 1 down, 2 forward).
-Vec3 camera_axis(const Camera& camera, int axis) {
-  return {camera.rotation(axis, 0), camera.rotation(axis, 1), camera.rotation(axis, 2)};
-}
-
-double determinant(const Mat3& a) {
-  return a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) -
-         a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
-         a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
-}
-
-// Cramer's rule; the caller checks that `a` is well conditioned.
-Vec3 solve(const Mat3& a, const Vec3& b) {
-  const double det = determinant(a);
-  double x[3];
-  for (int column = 0; column < 3; ++column) {
-    Mat3 replaced = a;
-    for (int row = 0; row < 3; ++row) replaced(row, column) = b[row];
-    x[column] = determinant(replaced) / det;
-  }
-  return {x[0], x[1], x[2]};
-}
-
 // Where the training cameras stand around their focus point: the world's up direction, the ellipse
 // fitted to their positions in the plane across it, and their mean height.
 struct Ring {
@@ -56,8 +32,8 @@ Vec3 up_direction(const std::vector<const Camera*>& cameras) {
   torch::Tensor moments = torch::zeros({3, 3}, torch::kFloat64);
   auto m = moments.accessor<double, 2>();
   for (const Camera* camera : cameras) {
-    mean_up = mean_up - camera_axis(*camera, 1);
-    const Vec3 right = camera_axis(*camera, 0);
+    mean_up = mean_up - camera->axis(1);
+    const Vec3 right = camera->axis(0);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) m[i][j] += right[i] * right[j];
   }
@@ -71,7 +47,13 @@ Vec3 up_direction(const std::vector<const Camera*>& cameras) {
 
 Ring fit_ring(const std::vector<const Camera*>& cameras) {
   Ring ring;
-  ring.focus = focus_point(cameras);
+  const std::optional<Vec3> focus = focus_point(cameras);
+  if (!focus)
+    fail(
+        "the {} training cameras look in parallel directions: no point to circle around (an "
+        "interpolated path follows the cameras instead)",
+        cameras.size());
+  ring.focus = *focus;
   ring.up = up_direction(cameras);
   // Any orthonormal basis of the plane across `up`.
   const Vec3 e1 =
@@ -178,28 +160,6 @@ Camera path_camera(const Camera& intrinsics_from, int index) {
 }
 
 }  // namespace
-
-Vec3 focus_point(const std::vector<const Camera*>& cameras) {
-  // Minimizes sum_i |(I - d_i d_i^T)(p - c_i)|^2 over p: the normal equations below.
-  Mat3 a;
-  a.m.fill(0);
-  Vec3 b;
-  for (const Camera* camera : cameras) {
-    const Vec3 d = camera_axis(*camera, 2);
-    Mat3 projector;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) projector(i, j) = (i == j) - d[i] * d[j];
-    for (int k = 0; k < 9; ++k) a.m[k] += projector.m[k];
-    b = b + projector * camera->center();
-  }
-  // Parallel optical axes (one camera, or a rig of parallel cameras) meet nowhere.
-  if (std::abs(determinant(a)) < 1e-6 * std::pow(double(cameras.size()), 3))
-    fail(
-        "the {} training cameras look in parallel directions: no point to circle around (an "
-        "interpolated path follows the cameras instead)",
-        cameras.size());
-  return solve(a, b);
-}
 
 std::vector<Camera> orbit_path(const std::vector<const Camera*>& cameras, int frames) {
   if (cameras.empty()) fail("a camera path needs at least one training camera");

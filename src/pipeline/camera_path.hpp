@@ -7,16 +7,13 @@
 
 namespace iesrgs::pipeline {
 
-// The point nearest to every camera's optical axis (least squares): what a capture looks at.
-// Fails when the axes are parallel.
-Vec3 focus_point(const std::vector<const Camera*>& cameras);
-
-// `frames` cameras looking at the focus point from the training cameras' mean height along the
-// world's up (the direction across every camera's right axis: cameras are held level). Around a
-// capture that goes all the way round (no gap between neighbouring cameras over a quarter turn),
-// they orbit the ellipse fitted to where the cameras stand (a circle of cameras gives that circle);
-// around a partial arc, they sweep along the arc the cameras cover, at their mean distance, and
-// back. They have the first camera's intrinsics and are named path_0000, path_0001, ...
+// `frames` cameras looking at the cameras' focus point (io/camera.hpp) from the training cameras'
+// mean height along the world's up (the direction across every camera's right axis: cameras are
+// held level). Around a capture that goes all the way round (no gap between neighbouring cameras
+// over a quarter turn), they orbit the ellipse fitted to where the cameras stand (a circle of
+// cameras gives that circle); around a partial arc, they sweep along the arc the cameras cover, at
+// their mean distance, and back. They have the first camera's intrinsics and are named path_0000,
+// path_0001, ...
 std::vector<Camera> orbit_path(const std::vector<const Camera*>& cameras, int frames);
 
 // `frames` cameras along a smooth curve through the cameras in their given order (the capture's

@@ -155,7 +155,8 @@ void validate(const TrainConfig& c) {
   require(c.grad_threshold > 0, "grad_threshold must be positive");
   require(c.max_gaussians >= 0, "max_gaussians must be 0 (no cap) or positive");
   require(c.init == "auto" || c.init == "random", "init must be \"auto\" or \"random\"");
-  require(c.random_points > 0 && c.random_extent > 0, "random init needs points and extent");
+  require(c.random_points > 0, "random init needs points");
+  require(c.random_extent >= 0, "random_extent must be 0 (from the scene) or positive");
   require(c.learning_rates.position_max_steps > 0, "lr_position_max_steps must be positive");
 }
 

@@ -42,7 +42,8 @@ struct TrainConfig {
 
   std::string init = "auto";  // auto (SfM points when the scene has some, else random), random
   int random_points = 100000;
-  float random_extent = 1.3f;
+  float random_extent = 0;  // half-size of their cube around the origin; 0: from the scene
+                            // (train::random_box)
 
   int64_t checkpoint_every = 1000;
   int64_t test_every = 1000;  // iterations between test PSNR reports; 0 = never

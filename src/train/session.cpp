@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <limits>
+#include <optional>
 
 #include "core/error.hpp"
 #include "io/image_tensor.hpp"
@@ -10,6 +12,13 @@
 #include "io/ply.hpp"
 
 namespace iesrgs::train {
+
+namespace {
+
+// 3DGS's random start for NeRF Synthetic scenes, whose objects fit in [-1.3, 1.3]^3.
+constexpr double kNerfSyntheticHalfExtent = 1.3;
+
+}  // namespace
 
 std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images,
                                   size_t limit) {
@@ -35,6 +44,22 @@ TrainerSetup scene_setup(const Scene& scene, ViewImages& images, size_t test_vie
   return setup;
 }
 
+RandomBox random_box(const Scene& scene, const TrainConfig& config) {
+  if (config.random_extent > 0) return {Vec3{}, config.random_extent};
+  if (scene.synthetic) return {Vec3{}, kNerfSyntheticHalfExtent};
+  const std::vector<const Camera*> cameras = scene.split(Split::Train);
+  if (cameras.empty()) fail_file(scene.root, "no training cameras to place random points around");
+  const std::optional<Vec3> focus = focus_point(cameras);
+  if (!focus) {
+    const SceneNormalization sphere = scene.normalization();
+    return {sphere.center, sphere.radius};
+  }
+  double nearest = std::numeric_limits<double>::max();
+  for (const Camera* camera : cameras)
+    nearest = std::min(nearest, (camera->center() - *focus).norm());
+  return {*focus, nearest};
+}
+
 gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
                                 const std::filesystem::path& init_ply) {
   if (!init_ply.empty()) {
@@ -48,9 +73,13 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
     return gs::model_from_point_cloud(scene.points);
   }
   require_training_memory(config.random_points);
-  spdlog::info("starting from {} random points in [-{}, {}]^3", config.random_points,
-               config.random_extent, config.random_extent);
-  return gs::model_from_random_box(config.random_points, config.random_extent, config.seed);
+  const RandomBox box = random_box(scene, config);
+  spdlog::info(
+      "starting from {} random points in the cube of half-size {:.3g} around ({:.3g}, "
+      "{:.3g}, {:.3g})",
+      config.random_points, box.half_extent, box.center.x, box.center.y, box.center.z);
+  return gs::model_from_random_box(config.random_points, float(box.half_extent), config.seed,
+                                   box.center);
 }
 
 void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianModel& model) {

@@ -22,8 +22,20 @@ std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& i
 TrainerSetup scene_setup(const Scene& scene, ViewImages& images, size_t test_views,
                          const std::filesystem::path& output_dir);
 
+// Where random starting points go: the cube of half-size `half_extent` around `center`.
+struct RandomBox {
+  Vec3 center;
+  double half_extent = 0;
+};
+
+// config.random_extent around the origin when it is positive. Otherwise (0, the default): for
+// NeRF Synthetic scenes 3DGS's cube of half-size 1.3 around the origin; for other scenes the cube
+// around what the training cameras look at (their focus point) that reaches the nearest of them,
+// or, when their axes are parallel, the cube around the scene's normalization sphere.
+RandomBox random_box(const Scene& scene, const TrainConfig& config);
+
 // The starting model: `init_ply` when given, else SfM points when the scene has them and the
-// config allows, else config.random_points in a box of half-size config.random_extent.
+// config allows, else config.random_points in random_box.
 gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
                                 const std::filesystem::path& init_ply);
 

@@ -101,6 +101,15 @@ TEST(GaussianModel, RandomBoxMatchesNerfSyntheticDefault) {
                            model_from_random_box(10, 1.f, 7).means));
 }
 
+TEST(GaussianModel, RandomBoxIsTheSamePointsMovedToItsCenter) {
+  const Vec3 center{2, -1, 0.5};
+  const torch::Tensor at_origin = model_from_random_box(1000, 0.5f, 3).means;
+  const torch::Tensor moved = model_from_random_box(1000, 0.5f, 3, center).means;
+  const torch::Tensor offset = torch::tensor({2.f, -1.f, 0.5f});
+  EXPECT_TRUE(torch::allclose(moved, at_origin + offset, 0, 1e-6));
+  EXPECT_LE((moved - offset).abs().max().item<float>(), 0.5f + 1e-6f);
+}
+
 // With a 3D filter and a lowered SH degree, which the PLY keeps and drops respectively.
 GaussianModel filtered_model(int64_t n) {
   GaussianModel m = random_model(n);

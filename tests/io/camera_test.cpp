@@ -1,11 +1,14 @@
 #include <gtest/gtest.h>
 
 #include "io/camera.hpp"
+#include "support/looking_cameras.hpp"
 #include "support/projection.hpp"
 
 namespace iesrgs {
 namespace {
 
+using testing::camera_at;
+using testing::pointers;
 using testing::project;
 
 TEST(Camera, OpenGlCameraToWorldBecomesOpenCvWorldToCamera) {
@@ -55,6 +58,20 @@ TEST(Camera, DistortionModelMatchesOpenCv) {
   EXPECT_NEAR(xd, 0.3 * radial + 2 * 0.001 * 0.3 * -0.2 + -0.002 * (r2 + 2 * 0.09), 1e-15);
   EXPECT_NEAR(yd, -0.2 * radial + 0.001 * (r2 + 2 * 0.04) + 2 * -0.002 * 0.3 * -0.2, 1e-15);
   EXPECT_FALSE(Distortion{}.any());
+}
+
+TEST(Camera, FocusPointIsWhereTheOpticalAxesMeet) {
+  const Vec3 target{0.3, -0.2, 0.5};
+  const std::vector<Camera> cameras = testing::ring(3, 2, 0.4, 1.5, target, 7);
+  const std::optional<Vec3> focus = focus_point(pointers(cameras));
+  ASSERT_TRUE(focus.has_value());
+  EXPECT_NEAR((*focus - target).norm(), 0, 1e-9);
+}
+
+TEST(Camera, ParallelCamerasHaveNoFocusPoint) {
+  const std::vector<Camera> cameras = {camera_at({0, 0, 0}, {0, 5, 0}),
+                                       camera_at({1, 0, 0}, {1, 5, 0})};
+  EXPECT_FALSE(focus_point(pointers(cameras)).has_value());
 }
 
 }  // namespace

@@ -34,17 +34,20 @@ class TrainerTest : public ::testing::Test {
     options.test_views = 2;
     options.seed = 5;
     synth::write_synth_dataset(dir_->path() / "scene", options);
+    scene_ = new Scene(load_scene(dir_->path() / "scene"));
   }
-  static void TearDownTestSuite() { delete dir_; }
+  static void TearDownTestSuite() {
+    delete scene_;
+    delete dir_;
+  }
 
   TrainerSetup setup(const std::filesystem::path& out) const {
-    scene_ = load_scene(dir_->path() / "scene");
-    ViewImages images(scene_);
+    ViewImages images(*scene_);
     TrainerSetup s;
-    s.train_views = load_views(scene_, Split::Train, images);
-    s.test_views = load_views(scene_, Split::Test, images);
-    s.background = scene_.background;
-    s.scene_extent = scene_.normalization().radius;
+    s.train_views = load_views(*scene_, Split::Train, images);
+    s.test_views = load_views(*scene_, Split::Test, images);
+    s.background = scene_->background;
+    s.scene_extent = scene_->normalization().radius;
     s.output_dir = out;
     return s;
   }
@@ -60,13 +63,14 @@ class TrainerTest : public ::testing::Test {
     return c;
   }
 
-  gs::GaussianModel initial() const { return initial_model(scene_, config(), {}); }
+  gs::GaussianModel initial() const { return initial_model(*scene_, config(), {}); }
 
   static TempDir* dir_;
-  mutable Scene scene_;
+  static Scene* scene_;
 };
 
 TempDir* TrainerTest::dir_ = nullptr;
+Scene* TrainerTest::scene_ = nullptr;
 
 std::vector<Camera> cameras(const TrainerSetup& s) {
   std::vector<Camera> result;
@@ -215,7 +219,7 @@ TEST_F(TrainerTest, EmptyStartingPlyIsAClearError) {
   TempDir dir;
   write_ply(dir / "empty.ply", SplatCloud{});
   const std::string message =
-      error_message([&] { initial_model(scene_, config(), dir / "empty.ply"); });
+      error_message([&] { initial_model(*scene_, config(), dir / "empty.ply"); });
   EXPECT_NE(message.find("empty.ply: has no Gaussians to start training from"), std::string::npos)
       << message;
 }
