@@ -58,7 +58,10 @@ NewRows split_children(const GaussianModel& model, const Tensor& mask) {
   }
   if (parents.filter_3d.defined()) rows.filter_3d = parents.filter_3d.repeat({kSplitSamples});
   Tensor& log_scales = rows.params[int(Param::LogScales)];
-  const Tensor offsets = torch::randn_like(log_scales) * log_scales.exp();
+  // Drawn by the CPU generator on every device: checkpoints keep its state, so a resumed run
+  // splits as the uninterrupted one, and a GPU run draws what a CPU run draws.
+  const Tensor noise = torch::randn(log_scales.sizes(), log_scales.options().device(torch::kCPU));
+  const Tensor offsets = noise.to(log_scales.device()) * log_scales.exp();
   const Tensor rotations = rotation_matrices(rows.params[int(Param::Quats)]);
   rows.params[int(Param::Means)] += torch::bmm(rotations, offsets.unsqueeze(2)).squeeze(2);
   // In log space: an axis whose exp underflows to 0 would otherwise get log(0).
