@@ -13,6 +13,7 @@
 #include "io/model_file.hpp"
 #include "io/scene.hpp"
 #include "io/view_images.hpp"
+#include "train/session.hpp"
 
 namespace iesrgs::cli {
 
@@ -38,6 +39,13 @@ void print_summary(const Scene& scene) {
   if (distorted)
     fmt::print("distortion  {} cameras, undistorted to pinhole when loaded\n", distorted);
   fmt::print("points      {}\n", scene.points.positions.size());
+  if (scene.points.positions.empty() && !scene.split(Split::Train).empty()) {
+    const train::RandomBox box = train::random_box(scene, train::TrainConfig{});
+    fmt::print(
+        "start       random points in the cube of half-size {:.3f} around ({:.3f}, {:.3f}, "
+        "{:.3f})\n",
+        box.half_extent, box.center.x, box.center.y, box.center.z);
+  }
   const SceneNormalization norm = scene.normalization();
   fmt::print("extent      center ({:.3f}, {:.3f}, {:.3f}) radius {:.3f}\n", norm.center.x,
              norm.center.y, norm.center.z, norm.radius);

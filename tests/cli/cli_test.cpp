@@ -52,6 +52,11 @@ TEST(Cli, SynthSceneLoadsAndDecodes) {
   EXPECT_EQ(info.status, 0) << info.output;
   EXPECT_TRUE(contains(info.output, "cameras     5 (3 train, 2 test)")) << info.output;
   EXPECT_TRUE(contains(info.output, "image size  32x32")) << info.output;
+  // A NeRF Synthetic scene without SfM points starts in 3DGS's cube.
+  EXPECT_TRUE(contains(
+      info.output,
+      "start       random points in the cube of half-size 1.300 around (0.000, 0.000, 0.000)"))
+      << info.output;
   EXPECT_TRUE(contains(info.output, "all 5 decoded")) << info.output;
 }
 
