@@ -54,12 +54,6 @@ void check_pair(const char* what, const at::Tensor& value, const at::Tensor& tar
   if (target.requires_grad()) fail("{}: the target must not require grad", what);
 }
 
-// Pearson has no CUDA kernel: device tensors run the CPU one on host copies, two image-sized
-// transfers per view.
-at::Tensor on_host(const at::Tensor& t) {
-  return t.to(at::kCPU).contiguous();
-}
-
 #ifdef IESRGS_WITH_CUDA
 // One SSIM workspace per thread, grown to the largest image and kept.
 cuda::Ssim& device_ssim() {
@@ -129,8 +123,8 @@ class PearsonFunction : public torch::autograd::Function<PearsonFunction> {
  public:
   static at::Tensor forward(AutogradContext* ctx, const at::Tensor& a_in, const at::Tensor& b_in,
                             const at::Tensor& mask_in) {
-    const at::Tensor a = on_host(a_in), b = on_host(b_in);
-    const at::Tensor mask = on_host(mask_in.to(at::kByte));
+    const at::Tensor a = a_in.contiguous(), b = b_in.contiguous();
+    const at::Tensor mask = mask_in.to(at::kByte).contiguous();
     const double correlation = with_scalar_type(a, [&](auto zero) {
       using T = decltype(zero);
       return pearson_correlation<T>(a.data_ptr<T>(), b.data_ptr<T>(), mask.data_ptr<uint8_t>(),
@@ -149,13 +143,13 @@ class PearsonFunction : public torch::autograd::Function<PearsonFunction> {
       pearson_correlation_backward<T>(a.data_ptr<T>(), b.data_ptr<T>(), mask.data_ptr<uint8_t>(),
                                       a.numel(), grads[0].item<double>(), grad_a.data_ptr<T>());
     });
-    return {grad_a.to(grads[0].device()), at::Tensor(), at::Tensor()};
+    return {grad_a, at::Tensor(), at::Tensor()};
   }
 };
 
 class GuidedTextureFunction : public torch::autograd::Function<GuidedTextureFunction> {
  public:
-  // An undefined `internal` travels as an empty tensor: autograd::Function takes defined ones.
+  // An undefined reference travels as an empty tensor: autograd::Function takes defined ones.
   static at::Tensor forward(AutogradContext* ctx, const at::Tensor& render_in,
                             const at::Tensor& internal_in, const at::Tensor& external_in,
                             const at::Tensor& share_in, double dssim_weight) {
@@ -165,9 +159,9 @@ class GuidedTextureFunction : public torch::autograd::Function<GuidedTextureFunc
     at::Tensor grad = at::zeros_like(render);
     const double loss = with_scalar_type(render, [&](auto zero) {
       using T = decltype(zero);
-      return guided_texture_loss<T>(
-          render.data_ptr<T>(), internal.numel() ? internal.data_ptr<T>() : nullptr,
-          external.data_ptr<T>(), share.data_ptr<T>(), shape, dssim_weight, grad.data_ptr<T>());
+      const auto data = [](const at::Tensor& t) { return t.numel() ? t.data_ptr<T>() : nullptr; };
+      return guided_texture_loss<T>(render.data_ptr<T>(), data(internal), data(external),
+                                    share.data_ptr<T>(), shape, dssim_weight, grad.data_ptr<T>());
     });
     // The loss is linear in its upstream gradient, so the full gradient is computed once here.
     ctx->save_for_backward({grad});
@@ -193,15 +187,38 @@ at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b, const at::
   check_pair("pearson", a, b);
   if (mask.defined() && mask.sizes() != a.sizes())
     fail("pearson: mask must have shape {}, not {}", c10::str(a.sizes()), c10::str(mask.sizes()));
-  // autograd::Function takes defined tensors only.
-  return PearsonFunction::apply(a, b, mask.defined() ? mask : at::ones(a.sizes(), at::kByte));
+  if (mask.defined() && mask.device() != a.device())
+    fail("pearson: the mask is on {}, the values on {}", c10::str(mask.device()),
+         c10::str(a.device()));
+  const at::Tensor selected =
+      mask.defined() ? mask : at::ones(a.sizes(), a.options().dtype(at::kByte));
+  if (!a.device().is_cpu())
+    return pearson_from_ops(a, b, selected);  // the kernel reads host memory
+  return PearsonFunction::apply(a, b, selected);
+}
+
+at::Tensor pearson_from_ops(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
+  // In double and centered, as the kernel sums, so that far depths keep their precision.
+  const at::Tensor weight = (mask != 0).to(at::kDouble);
+  const at::Tensor x = a.to(at::kDouble), y = b.to(at::kDouble);
+  const at::Tensor count = weight.sum();
+  const at::Tensor dx = weight * (x - (weight * x).sum() / count.clamp_min(1));
+  const at::Tensor dy = weight * (y - (weight * y).sum() / count.clamp_min(1));
+  const at::Tensor xx = (dx * dx).sum(), yy = (dy * dy).sum();
+  // An undefined correlation (fewer than two entries, or a constant side) is 0, as in the kernel;
+  // the clamp keeps the unused branch's gradient finite.
+  const at::Tensor defined = (count >= 2) & (xx > 0) & (yy > 0);
+  const at::Tensor correlation = (dx * dy).sum() / (xx * yy).clamp_min(1e-300).sqrt();
+  return at::where(defined, correlation, at::zeros_like(correlation)).to(a.scalar_type());
 }
 
 at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& internal,
                                    const at::Tensor& external, const at::Tensor& internal_share,
                                    double dssim_weight) {
-  check_pair("guided texture (external)", render, external);
+  if (!internal.defined() && !external.defined())
+    fail("guided texture: neither the internal nor the external image is given");
   if (internal.defined()) check_pair("guided texture (internal)", render, internal);
+  if (external.defined()) check_pair("guided texture (external)", render, external);
   const auto expected = render.sizes().slice(1);
   if (!internal_share.defined() || internal_share.sizes() != expected ||
       internal_share.scalar_type() != render.scalar_type())
@@ -211,8 +228,9 @@ at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& i
     require_ssim_kernel_for(render, "guided texture");
     return guided_texture_from_ops(render, internal, external, internal_share, dssim_weight);
   }
-  return GuidedTextureFunction::apply(render, internal.defined() ? internal : at::empty({0}),
-                                      external, internal_share, dssim_weight);
+  const auto given = [](const at::Tensor& t) { return t.defined() ? t : at::empty({0}); };
+  return GuidedTextureFunction::apply(render, given(internal), given(external), internal_share,
+                                      dssim_weight);
 }
 
 at::Tensor guided_texture_from_ops(const at::Tensor& render, const at::Tensor& internal,
@@ -225,14 +243,11 @@ at::Tensor guided_texture_from_ops(const at::Tensor& render, const at::Tensor& i
     const at::Tensor ssim_map = ssim_autograd(render, reference).map;
     return (share * ((1 - dssim_weight) * l1_map + dssim_weight * (1 - ssim_map))).sum() / pixels;
   };
+  // Each reference given is evaluated, even where its share is zero: checking the share would
+  // read it back from the GPU every step.
   at::Tensor loss = at::zeros({}, render.options());
-  // As the kernel, a reference whose share is zero everywhere is not evaluated.
-  if (internal_share.ne(0).any().item<bool>()) {
-    if (!internal.defined()) fail("guided_texture_loss: internal share without an image");
-    loss = loss + term(internal, internal_share);
-  }
-  const at::Tensor external_share = 1 - internal_share;
-  if (external_share.ne(0).any().item<bool>()) loss = loss + term(external, external_share);
+  if (internal.defined()) loss = loss + term(internal, internal_share);
+  if (external.defined()) loss = loss + term(external, 1 - internal_share);
   return loss;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
-// SSIM and Pearson correlation as torch autograd functions backed by the CPU kernels, so that they
-// compose with tensor losses. CPU tensors, float32 or float64; the second argument is a constant
-// target (passing one that requires grad is an error).
+// SSIM, Pearson correlation and the fusion texture loss as torch autograd functions backed by the
+// hand-written kernels, so that they compose with tensor losses. CPU tensors, float32 or float64,
+// and in a CUDA build float32 tensors on a GPU; the second argument is a constant target (passing
+// one that requires grad is an error).
 #include <ATen/core/Tensor.h>
 
 #include "loss/image_shape.hpp"
@@ -25,15 +26,23 @@ SsimTensors ssim_autograd(const at::Tensor& x, const at::Tensor& y);
 at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b,
                             const at::Tensor& mask = at::Tensor());
 
+// The same composed of tensor ops in float64, which is what tensors on a GPU take (the kernel of
+// loss/pearson.hpp works on host arrays); equal in value and gradient, and it reads nothing back to
+// the host. `mask` is defined.
+at::Tensor pearson_from_ops(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
+
 // The fusion stage's texture loss (loss/texture_fusion.hpp) of a render (C, H, W) against the
-// internal and external references, `internal_share` (H, W) choosing between them per pixel;
-// `internal` may be undefined when the share is zero everywhere. Differentiable in render.
+// internal and external references, `internal_share` (H, W) choosing between them per pixel. A
+// reference whose share is zero everywhere may be undefined (the internal one for E alone, the
+// external one for I alone); on the CPU a share without its reference is an error. Differentiable
+// in render.
 at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& internal,
                                    const at::Tensor& external, const at::Tensor& internal_share,
                                    double dssim_weight);
 
 // The same loss composed of tensor ops around ssim_autograd, which is what tensors on a GPU take
-// (the kernel of loss/texture_fusion.hpp works on host arrays); equal in value and gradient.
+// (the kernel of loss/texture_fusion.hpp works on host arrays); equal in value and gradient. It
+// evaluates every reference given, and reads nothing back to the host.
 at::Tensor guided_texture_from_ops(const at::Tensor& render, const at::Tensor& internal,
                                    const at::Tensor& external, const at::Tensor& internal_share,
                                    double dssim_weight);

@@ -23,14 +23,14 @@ torch::Tensor map_tensor(const std::vector<T>& values, const ImageShape& shape,
       .to(torch::kFloat);
 }
 
-// L1 between the render's expected depth and I_depth where both saw a surface.
+// L1 between the render's expected depth and I_depth where both saw a surface: the mean over those
+// pixels, 0 where there are none, without reading their count back to the host.
 torch::Tensor internal_depth_loss(const raster::RenderOutput& render,
                                   const torch::Tensor& internal_depth,
                                   const torch::Tensor& covered) {
-  const torch::Tensor valid = covered & (internal_depth > 0);
-  if (!valid.any().item<bool>()) return torch::zeros({}, render.depth.options());
+  const torch::Tensor valid = (covered & (internal_depth > 0)).to(render.depth.scalar_type());
   const torch::Tensor expected = render.depth / render.alpha.clamp_min(1e-6);
-  return (expected - internal_depth).abs().masked_select(valid).mean();
+  return ((expected - internal_depth).abs() * valid).sum() / valid.sum().clamp_min(1);
 }
 
 // 1 - corr(rendered inverse depth, E_depth) over the covered pixels, as SparseGS relaxes depth.
@@ -98,26 +98,26 @@ torch::Tensor internal_share(TextureGuidance guidance, const torch::Tensor& inte
 
 FusionLossTerms fusion_loss(const raster::RenderOutput& render, const FusionTargets& targets,
                             const FusionWeights& weights) {
-  const bool uses_internal = weights.texture != TextureGuidance::External;
-  const torch::Tensor& external =
-      targets.external_image.defined() ? targets.external_image : targets.internal_image;
+  const TextureGuidance guidance = weights.texture;
+  const torch::Tensor none;
   FusionLossTerms terms;
-  terms.total = guided_texture_autograd(render.image,
-                                        uses_internal ? targets.internal_image : torch::Tensor(),
-                                        external, targets.internal_share, weights.dssim_weight);
-  terms.texture = terms.total.item<double>();
+  terms.total = guided_texture_autograd(
+      render.image, guidance == TextureGuidance::External ? none : targets.internal_image,
+      guidance == TextureGuidance::Internal ? none : targets.external_image, targets.internal_share,
+      weights.dssim_weight);
+  terms.texture = terms.total.detach();
   const bool internal_depth = weights.internal_depth > 0 && targets.internal_depth.defined();
   const bool external_depth = weights.external_depth > 0 && targets.external_disparity.defined();
   if (!internal_depth && !external_depth) return terms;
   const torch::Tensor covered = render.alpha.detach() >= kDepthCoverageAlpha;
   if (internal_depth) {
     const torch::Tensor l = internal_depth_loss(render, targets.internal_depth, covered);
-    terms.internal_depth = l.item<double>();
+    terms.internal_depth = l.detach();
     terms.total = terms.total + weights.internal_depth * l;
   }
   if (external_depth) {
     const torch::Tensor l = external_depth_loss(render, targets.external_disparity, covered);
-    terms.external_depth = l.item<double>();
+    terms.external_depth = l.detach();
     terms.total = terms.total + weights.external_depth * l;
   }
   return terms;

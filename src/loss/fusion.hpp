@@ -53,9 +53,12 @@ torch::Tensor internal_share(TextureGuidance guidance, const torch::Tensor& inte
 // Pixels whose render covers them (alpha >= 0.5), the only ones the depth terms look at.
 constexpr double kDepthCoverageAlpha = 0.5;
 
+// Scalar tensors where the render is: nothing here is read back to the host, which would make a
+// GPU wait for every step.
 struct FusionLossTerms {
-  torch::Tensor total;                                         // differentiable
-  double texture = 0, internal_depth = 0, external_depth = 0;  // unweighted, for logs
+  torch::Tensor total;  // differentiable
+  // Unweighted and detached, for logs; undefined when the term is off.
+  torch::Tensor texture, internal_depth, external_depth;
 };
 
 FusionLossTerms fusion_loss(const raster::RenderOutput& render, const FusionTargets& targets,

@@ -50,6 +50,7 @@ double guided_texture_loss(const T* render, const T* internal, const T* external
     uses_external |= external_weight[p] != 0;
   }
   if (uses_internal && !internal) fail("guided_texture_loss: internal share without an image");
+  if (uses_external && !external) fail("guided_texture_loss: external share without an image");
   double loss = 0;
   if (uses_internal)
     loss += weighted_photometric_loss(render, internal, shape, lambda, internal_weight.data(),

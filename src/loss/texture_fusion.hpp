@@ -26,8 +26,9 @@ std::vector<uint8_t> discrepancy_mask(const T* internal, const T* external, cons
 // L_tex = mean_p(S(p) * l_I(p) + (1 - S(p)) * l_E(p)), l_ref the photometric map
 // (1 - lambda) * l1_map + lambda * (1 - ssim_map) of the render against ref, and S the internal
 // share per pixel: the mask M for IE-SRGS, 0.5 to average both references, 0 for E alone (then
-// `internal` may be null). A reference whose share is zero everywhere is not evaluated. Adds the
-// gradient with respect to the render to grad_render when non-null.
+// `internal` may be null), 1 for I alone (then `external` may be null). A reference whose share
+// is zero everywhere is not evaluated. Adds the gradient with respect to the render to
+// grad_render when non-null.
 template <typename T>
 double guided_texture_loss(const T* render, const T* internal, const T* external,
                            const T* internal_share, const ImageShape& shape, double lambda,

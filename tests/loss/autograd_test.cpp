@@ -128,7 +128,7 @@ TEST(SsimAutograd, CudaMatchesCpu) {
             1e-5);
 }
 
-// Pearson has no CUDA kernel: device tensors take the CPU one on host copies.
+// Device tensors take the tensor-ops version.
 TEST(PearsonAutograd, CudaTensorsGiveTheCpuResult) {
   IESRGS_SKIP_WITHOUT_CUDA();
   torch::manual_seed(2);
@@ -209,6 +209,38 @@ TEST(PearsonAutograd, FloatMatchesTorchOpsInDouble) {
   EXPECT_LT(max_difference(x.grad(), ref.grad()), 1e-5);
 }
 
+// Value and gradient of pearson_autograd's kernel and of pearson_from_ops.
+std::pair<at::Tensor, at::Tensor> pearson_with_gradient(bool ops, const at::Tensor& a,
+                                                        const at::Tensor& b,
+                                                        const at::Tensor& mask) {
+  const at::Tensor x = a.clone().requires_grad_(true);
+  const at::Tensor correlation = ops ? pearson_from_ops(x, b, mask) : pearson_autograd(x, b, mask);
+  correlation.backward();
+  return {correlation.detach(), x.grad()};
+}
+
+TEST(PearsonAutograd, TensorOpsMatchTheKernel) {
+  torch::manual_seed(4);
+  const at::Tensor a = torch::rand({21, 16}) + 3, b = torch::rand({21, 16}) - 0.5 * a;
+  const at::Tensor some = torch::rand({21, 16}) > 0.4;
+  at::Tensor one = torch::zeros({21, 16}, torch::kBool);
+  one[3][5] = true;
+  // A constant side and a single entry leave the correlation undefined: 0, with a zero gradient.
+  const std::vector<std::pair<at::Tensor, at::Tensor>> cases = {
+      {a, some},
+      {a, torch::ones({21, 16}, torch::kBool)},
+      {torch::full({21, 16}, 2.f), some},
+      {a, one}};
+  for (const auto& [values, mask] : cases) {
+    const auto [expected, expected_grad] = pearson_with_gradient(false, values, b, mask);
+    const auto [actual, actual_grad] = pearson_with_gradient(true, values, b, mask);
+    EXPECT_EQ(actual.scalar_type(), at::kFloat);
+    EXPECT_LT(max_difference(actual, expected), 1e-6);
+    EXPECT_LT(max_difference(actual_grad, expected_grad), 1e-6);
+    EXPECT_TRUE(torch::isfinite(actual_grad).all().item<bool>());
+  }
+}
+
 // The share maps of the fusion rows: the mask M (IE-SRGS), both references averaged, E alone.
 std::vector<at::Tensor> texture_shares(int64_t height, int64_t width, at::ScalarType dtype) {
   torch::manual_seed(7);
@@ -237,6 +269,25 @@ TEST(GuidedTextureAutograd, TensorOpsMatchTheKernel) {
             1e-12);
 }
 
+TEST(GuidedTextureAutograd, InternalAloneNeedsNoExternalImage) {
+  const Images images = random_images(at::kDouble);
+  const at::Tensor all_internal = torch::ones({23, 31}, at::kDouble);
+  const at::Tensor x = images.x.clone().requires_grad_(true);
+  const at::Tensor y = images.x.clone().requires_grad_(true);
+  const at::Tensor kernel = guided_texture_autograd(x, images.y, {}, all_internal, 0.2);
+  const at::Tensor ops = guided_texture_from_ops(y, images.y, {}, all_internal, 0.2);
+  kernel.backward();
+  ops.backward();
+  EXPECT_LT(max_difference(ops, kernel), 1e-12);
+  EXPECT_LT(max_difference(y.grad(), x.grad()), 1e-12);
+  EXPECT_EQ(testing::error_message(
+                [&] { guided_texture_autograd(images.x, images.y, {}, all_internal * 0.5, 0.2); }),
+            "guided_texture_loss: external share without an image");
+  EXPECT_EQ(
+      testing::error_message([&] { guided_texture_autograd(images.x, {}, {}, all_internal, 0.2); }),
+      "guided texture: neither the internal nor the external image is given");
+}
+
 TEST(GuidedTextureAutograd, CudaMatchesCpu) {
   IESRGS_SKIP_WITHOUT_CUDA();
   const Images images = random_images(at::kFloat);
@@ -260,6 +311,10 @@ TEST(PearsonAutograd, MaskOfAnotherShapeIsAnError) {
               pearson_autograd(a, a, torch::ones({5, 4}) > 0);
             }),
             "pearson: mask must have shape [4, 5], not [5, 4]");
+  EXPECT_EQ(testing::error_message([&] {
+              pearson_autograd(a, a, torch::ones({4, 5}, torch::Device(torch::kMeta)) > 0);
+            }),
+            "pearson: the mask is on meta, the values on cpu");
 }
 
 }  // namespace

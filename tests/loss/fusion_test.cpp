@@ -83,8 +83,8 @@ TEST(FusionLoss, DepthTermsVanishForMatchingGeometryAndIgnoreUncoveredPixels) {
   targets.internal_depth.narrow(1, 0, 3).fill_(100);
   targets.external_disparity.narrow(1, 0, 3).fill_(-7);
   const FusionLossTerms terms = fusion_loss(render, targets, kDepthWeights);
-  EXPECT_NEAR(terms.internal_depth, 0, 1e-5);
-  EXPECT_NEAR(terms.external_depth, 0, 1e-5);
+  EXPECT_NEAR(terms.internal_depth.item<double>(), 0, 1e-5);
+  EXPECT_NEAR(terms.external_depth.item<double>(), 0, 1e-5);
 }
 
 TEST(FusionLoss, DepthTermsPullTheRenderedDepthTowardsTheReferences) {
@@ -95,12 +95,24 @@ TEST(FusionLoss, DepthTermsPullTheRenderedDepthTowardsTheReferences) {
   torch::manual_seed(3);
   targets.external_disparity = torch::rand({kHeight, kWidth});
   const FusionLossTerms terms = fusion_loss(render, targets, kDepthWeights);
-  EXPECT_NEAR(terms.internal_depth, 0.5, 1e-5);
-  EXPECT_GT(terms.external_depth, 0.1);
+  EXPECT_NEAR(terms.internal_depth.item<double>(), 0.5, 1e-5);
+  EXPECT_GT(terms.external_depth.item<double>(), 0.1);
   terms.total.backward();
   // The internal term alone would push every rendered depth up (negative gradient).
   EXPECT_TRUE(render.depth.grad().defined());
   EXPECT_GT(render.depth.grad().abs().sum().item<double>(), 0);
+}
+
+TEST(FusionLoss, InternalDepthTermIsZeroWhereNothingIsCovered) {
+  raster::RenderOutput render = render_with_depth(1 + torch::rand({kHeight, kWidth}), kWidth);
+  FusionTargets targets = external_targets(8);
+  targets.internal_depth = torch::full({kHeight, kWidth}, 2.0);
+  const FusionLossTerms terms =
+      fusion_loss(render, targets, {TextureGuidance::External, 0.2, 1e-3, 0});
+  EXPECT_EQ(terms.internal_depth.item<double>(), 0);
+  EXPECT_FALSE(terms.external_depth.defined());
+  terms.total.backward();
+  EXPECT_EQ(render.depth.grad().abs().sum().item<double>(), 0);
 }
 
 TEST(FusionLoss, MissingReferenceOrUnknownGuidanceIsAnError) {
