@@ -200,10 +200,12 @@ at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b, const at::
 at::Tensor pearson_from_ops(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
   // In double and centered, as the kernel sums, so that far depths keep their precision.
   const at::Tensor weight = (mask != 0).to(at::kDouble);
-  const at::Tensor x = a.to(at::kDouble), y = b.to(at::kDouble);
   const at::Tensor count = weight.sum();
-  const at::Tensor dx = weight * (x - (weight * x).sum() / count.clamp_min(1));
-  const at::Tensor dy = weight * (y - (weight * y).sum() / count.clamp_min(1));
+  const auto centered = [&](const at::Tensor& t) {  // minus the selected mean; 0 off the mask
+    const at::Tensor v = t.to(at::kDouble);
+    return weight * (v - (weight * v).sum() / count.clamp_min(1));
+  };
+  const at::Tensor dx = centered(a), dy = centered(b);
   const at::Tensor xx = (dx * dx).sum(), yy = (dy * dy).sum();
   // An undefined correlation (fewer than two entries, or a constant side) is 0, as in the kernel;
   // the clamp keeps the unused branch's gradient finite.

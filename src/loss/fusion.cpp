@@ -99,11 +99,19 @@ torch::Tensor internal_share(TextureGuidance guidance, const torch::Tensor& inte
 FusionLossTerms fusion_loss(const raster::RenderOutput& render, const FusionTargets& targets,
                             const FusionWeights& weights) {
   const TextureGuidance guidance = weights.texture;
-  const torch::Tensor none;
+  const bool uses_internal = guidance != TextureGuidance::External;
+  const bool uses_external = guidance != TextureGuidance::Internal;
+  // Checked from the guidance, not from the share, which on a GPU would mean reading it back.
+  const auto reference = [&](bool used, const torch::Tensor& image, const char* what) {
+    if (used && !image.defined())
+      fail("fusion loss: the {} texture guidance needs the {} image",
+           texture_guidance_name(guidance), what);
+    return used ? image : torch::Tensor();
+  };
   FusionLossTerms terms;
   terms.total = guided_texture_autograd(
-      render.image, guidance == TextureGuidance::External ? none : targets.internal_image,
-      guidance == TextureGuidance::Internal ? none : targets.external_image, targets.internal_share,
+      render.image, reference(uses_internal, targets.internal_image, "internal"),
+      reference(uses_external, targets.external_image, "external"), targets.internal_share,
       weights.dssim_weight);
   terms.texture = terms.total.detach();
   const bool internal_depth = weights.internal_depth > 0 && targets.internal_depth.defined();

@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "loss/autograd.hpp"
+#include "support/expect_error.hpp"
 
 namespace iesrgs::loss {
 namespace {
@@ -124,6 +125,12 @@ TEST(FusionLoss, MissingReferenceOrUnknownGuidanceIsAnError) {
   targets.external_image = random_image(2);
   targets.internal_share = torch::ones({kHeight, kWidth});  // asks for the absent internal image
   EXPECT_THROW(fusion_loss(render, targets, {TextureGuidance::Masked, 0.2, 0, 0}), Error);
+  targets.external_image = torch::Tensor();
+  targets.internal_share = torch::zeros({kHeight, kWidth});
+  EXPECT_EQ(testing::error_message([&] {
+              fusion_loss(render, targets, {TextureGuidance::External, 0.2, 0, 0});
+            }),
+            "fusion loss: the external texture guidance needs the external image");
 }
 
 }  // namespace
