@@ -2,16 +2,12 @@
 # On a machine with an NVIDIA GPU, the CUDA toolkit, CMake and a C++ compiler: builds iesrgs with
 # its CUDA kernels and checks them.
 #   scripts/cuda-check.sh [--deps DIR] [--kernels-only] [--quick] [benchmark options, e.g. --cpu]
-#   scripts/cuda-check.sh [--deps DIR] --cpu-asan
 #   scripts/cuda-check.sh --fetch-deps DIR
 # The full build links the LibTorch of the machine's PyTorch (python3 -c 'import torch'), runs the
 # main suite's GPU tests (rendering, SSIM, Adam and training through LibTorch, against the CPU),
 # trains the same synthetic scene on the CPU and on the GPU and prints both results, then runs the
 # whole suite.
 # --kernels-only builds the kernels alone (no LibTorch) and ends with their benchmark at 800x800.
-# --cpu-asan builds the suite without CUDA but against the same LibTorch, under AddressSanitizer
-# and UBSan, and runs its CPU trainings: in-process CPU training has crashed in builds against
-# PyTorch's LibTorch and never in builds against Debian's.
 # Both run the kernels' own tests, then again under compute-sanitizer (memcheck, racecheck) unless
 # --quick.
 # Where the GPU machine lacks the Debian libraries and cannot install them, --fetch-deps downloads
@@ -42,18 +38,6 @@ fi
 torch_prefix() { python3 -c 'import torch; print(torch.utils.cmake_prefix_path)'; }
 # Which OpenMP and CUDA runtimes a binary loads: PyTorch's wheels bring their own.
 runtimes() { ldd "$1" | grep -E 'gomp|omp5|libomp|cudart' || true; }
-if [ "${1:-}" = "--cpu-asan" ]; then
-  prefix_path+=("$(torch_prefix)")
-  prefixes=$(IFS=';'; echo "${prefix_path[*]}")
-  # The options of `scripts/test.sh --asan`.
-  cmake -S . -B build-cpu-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG" -DIESRGS_SANITIZE=ON -DIESRGS_BENCH=OFF \
-    -DIESRGS_CUDA=OFF "-DCMAKE_PREFIX_PATH=$prefixes" >/dev/null
-  cmake --build build-cpu-asan -j "$(nproc)" --target iesrgs_tests
-  runtimes build-cpu-asan/tests/iesrgs_tests
-  ASAN_OPTIONS=detect_leaks=0 build-cpu-asan/tests/iesrgs_tests --gtest_filter='TrainerTest.*'
-  exit
-fi
 kernels_only=false
 if [ "${1:-}" = "--kernels-only" ]; then
   kernels_only=true
