@@ -5,6 +5,9 @@
 #include <string>
 
 #include "core/error.hpp"
+#ifdef IESRGS_WITH_CUDA
+#include "core/cuda/device.hpp"
+#endif
 
 namespace iesrgs {
 
@@ -35,15 +38,19 @@ int64_t peak_memory_bytes() {
   return std::max<int64_t>(0, proc_kib_field("/proc/self/status", "VmHWM:"));
 }
 
-int64_t available_memory_bytes() {
-  return proc_kib_field("/proc/meminfo", "MemAvailable:");
+int64_t available_memory_bytes(torch::Device device) {
+  if (device.is_cpu()) return proc_kib_field("/proc/meminfo", "MemAvailable:");
+#ifdef IESRGS_WITH_CUDA
+  if (device.is_cuda()) return cuda::free_memory_bytes();
+#endif
+  return -1;
 }
 
-void require_memory(int64_t bytes, const std::string& what) {
-  const int64_t available = available_memory_bytes();
+void require_memory(int64_t bytes, const std::string& what, torch::Device device) {
+  const int64_t available = available_memory_bytes(device);
   if (available >= 0 && bytes > available)
-    fail("not enough memory: {} needs about {:.1f} GiB, and {:.1f} GiB is available", what,
-         gib(bytes), gib(available));
+    fail("not enough {}memory: {} needs about {:.1f} GiB, and {:.1f} GiB is available",
+         device.is_cpu() ? "" : "GPU ", what, gib(bytes), gib(available));
 }
 
 }  // namespace iesrgs

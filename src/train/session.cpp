@@ -72,7 +72,7 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
     spdlog::info("starting from {} SfM points", scene.points.positions.size());
     return gs::model_from_point_cloud(scene.points);
   }
-  require_training_memory(config.random_points);
+  require_training_memory(config.random_points, compute_device());
   const RandomBox box = random_box(scene, config);
   spdlog::info(
       "starting from {} random points in the cube of half-size {:.3g} around ({:.3g}, "

@@ -104,14 +104,15 @@ gs::DensifyOptions densify_options(const TrainConfig& c, int64_t iteration) {
 
 }  // namespace
 
-void require_training_memory(int64_t gaussians) {
-  require_memory(gaussians * kBytesPerGaussian, fmt::format("training {} Gaussians", gaussians));
+void require_training_memory(int64_t gaussians, torch::Device device) {
+  require_memory(gaussians * kBytesPerGaussian, fmt::format("training {} Gaussians", gaussians),
+                 device);
 }
 
 Trainer::Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianModel initial)
     : config_(config), setup_(std::move(setup)), model_(std::move(initial)) {
   validate(config_);
-  require_training_memory(model_.size());
+  require_training_memory(model_.size(), device_);
   if (setup_.train_views.empty()) fail("training needs at least one view");
   for (const TrainView& view : setup_.train_views) train_cameras_.push_back(view.camera);
   torch::manual_seed(config_.seed);
@@ -268,8 +269,9 @@ void Trainer::warn_memory_cap(int64_t iteration, int64_t cap, int64_t held_back)
 }
 
 int64_t Trainer::densify_cap() const {
-  // Linux overcommits: growing past the available memory would get the process killed later.
-  const int64_t available = available_memory_bytes();
+  // Linux overcommits: growing past the available memory would get the process killed later, and
+  // on a GPU stop the run with an out-of-memory error.
+  const int64_t available = available_memory_bytes(device_);
   const int64_t configured =
       config_.max_gaussians > 0 ? config_.max_gaussians : std::numeric_limits<int64_t>::max();
   if (available < 0) return configured;

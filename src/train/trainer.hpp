@@ -39,8 +39,9 @@ struct TrainerSetup {
   ViewLoss loss;                     // empty: the photometric default
 };
 
-// Fails up front when training `gaussians` Gaussians would not fit in the available memory.
-void require_training_memory(int64_t gaussians);
+// Fails up front when training `gaussians` Gaussians would not fit in the available memory of
+// `device`.
+void require_training_memory(int64_t gaussians, torch::Device device);
 
 struct TrainSummary {
   int64_t iterations = 0;            // completed in total (including before a resume)
