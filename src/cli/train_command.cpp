@@ -90,7 +90,10 @@ void run_train(const TrainArgs& args) {
                                : train::Trainer(config, std::move(setup),
                                                 train::initial_model(scene, config, args.init_ply));
   const train::TrainSummary summary = trainer.run();
-  if (summary.interrupted) return;
+  if (summary.interrupted) {
+    fmt::print("continue with the same command and --resume\n");
+    return;
+  }
   train::write_point_clouds(out, trainer.model());
 
   const nlohmann::json report = {{"scene", scene.root.string()},

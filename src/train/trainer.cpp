@@ -343,8 +343,8 @@ TrainSummary Trainer::run() {
         (config_.checkpoint_every > 0 && iteration_ % config_.checkpoint_every == 0))
       save_checkpoint();
     if (interrupted) {
-      fmt::print("interrupted: checkpoint of iteration {} saved to {}; continue with --resume\n",
-                 iteration_, checkpoint_path().string());
+      fmt::print("interrupted: checkpoint of iteration {} saved to {}\n", iteration_,
+                 checkpoint_path().string());
       summary.interrupted = true;
       break;
     }
