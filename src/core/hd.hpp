@@ -12,21 +12,35 @@
 
 namespace iesrgs::hd {
 
+// The math functions are templates so that the CPU kernels can specialize them for their SIMD
+// lanes (raster/cpu/lanes.hpp) and run the same formulas on several Gaussians at once.
 #if defined(__CUDACC__)
-using ::ceil;
-using ::exp;
-using ::floor;
-using ::isfinite;
-using ::log;
-using ::sqrt;
+#define IESRGS_HD_MATH ::
 #else
-using std::ceil;
-using std::exp;
-using std::floor;
-using std::isfinite;
-using std::log;
-using std::sqrt;
+#define IESRGS_HD_MATH std::
 #endif
+using IESRGS_HD_MATH isfinite;
+template <typename T>
+IESRGS_HD T ceil(T x) {
+  return IESRGS_HD_MATH ceil(x);
+}
+template <typename T>
+IESRGS_HD T floor(T x) {
+  return IESRGS_HD_MATH floor(x);
+}
+template <typename T>
+IESRGS_HD T exp(T x) {
+  return IESRGS_HD_MATH exp(x);
+}
+template <typename T>
+IESRGS_HD T log(T x) {
+  return IESRGS_HD_MATH log(x);
+}
+template <typename T>
+IESRGS_HD T sqrt(T x) {
+  return IESRGS_HD_MATH sqrt(x);
+}
+#undef IESRGS_HD_MATH
 
 template <typename T>
 IESRGS_HD T min(T a, T b) {
@@ -35,6 +49,16 @@ IESRGS_HD T min(T a, T b) {
 template <typename T>
 IESRGS_HD T max(T a, T b) {
   return a < b ? b : a;
+}
+
+// What comparing two T gives: bool for scalars, a lane mask for SIMD packs.
+template <typename T>
+using Mask = decltype(T() < T());
+
+// a where cond holds, else b; without branching on packs.
+template <typename T>
+IESRGS_HD T select(Mask<T> cond, T a, T b) {
+  return cond ? a : b;
 }
 
 }  // namespace iesrgs::hd

@@ -67,10 +67,9 @@ IESRGS_HD raster::Sym2<T> filter2d_backward(const raster::Sym2<T>& cov, bool ant
   raster::Sym2<T> filtered;
   const T factor = filter2d(cov, antialiased, filtered);
   const T det0 = raster::det(cov), det1 = raster::det(filtered);
-  if (det0 / det1 <= T(kMinMipDetRatio)) return dcov;
-  // factor = sqrt(det0 / det1); d det / d(xx, xy, yy) = (yy, -2 xy, xx)
-  const T g = dfactor / (T(2) * factor * det1);
   const T r = det0 / det1;
+  // factor = sqrt(det0 / det1); d det / d(xx, xy, yy) = (yy, -2 xy, xx)
+  const T g = hd::select(r <= T(kMinMipDetRatio), T(0), dfactor / (T(2) * factor * det1));
   dcov.xx += g * (cov.yy - r * filtered.yy);
   dcov.xy += g * T(-2) * (cov.xy - r * filtered.xy);
   dcov.yy += g * (cov.xx - r * filtered.xx);

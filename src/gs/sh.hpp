@@ -96,7 +96,7 @@ IESRGS_HD void sh_to_color_backward(int degree, const T* sh, const raster::Vec3T
   for (int c = 0; c < 3; ++c) {
     T sum = T(0.5);
     for (int k = 0; k < count; ++k) sum += b[k] * sh[3 * k + c];
-    live[c] = sum < T(0) ? T(0) : dcolor[c];
+    live[c] = hd::select(sum < T(0), T(0), dcolor[c]);
   }
   raster::Vec3T<T> ddir{0, 0, 0};
   for (int k = 0; k < kShCoefficients; ++k)

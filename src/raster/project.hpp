@@ -30,13 +30,50 @@ struct Projection {
   Mat3T<T> rot;    // Gaussian rotation
   Mat3T<T> sigma;  // world-space covariance
   T tx, ty;        // camera x, y after clamping x / z and y / z
-  bool clamped_x, clamped_y;
+  hd::Mask<T> clamped_x, clamped_y;
   T jw[2][3];        // J W: Jacobian of the projection times the camera rotation
   Sym2<T> cov;       // screen-space covariance before the 2D filter
   Sym2<T> filtered;  // after the 2D filter
   T opacity2d;       // 2D filter opacity factor
   Sym2<T> conic;     // inverse of filtered
   T filtered_det;    // det(filtered), computed without cancellation
+};
+
+// One Gaussian's parameters as the projection reads them: row i of GaussianParams in place, or,
+// with T a SIMD pack, one Gaussian per lane (raster/cpu/project.cpp).
+template <typename T>
+struct GaussianRow {
+  Vec3T<T> mean;
+  const T* log_scale;  // (3)
+  const T* quat;       // (4)
+  T opacity_logit;
+  T filter_std;  // 0 without the 3D filter
+  const T* sh;   // (16, 3)
+  int sh_degree;
+  bool antialiased;
+};
+
+template <typename T>
+IESRGS_HD GaussianRow<T> gaussian_row(const GaussianParams<T>& g, int i) {
+  return {{g.means[3 * i], g.means[3 * i + 1], g.means[3 * i + 2]},
+          g.log_scales + 3 * i,
+          g.quats + 4 * i,
+          g.opacity_logits[i],
+          g.filter_std ? g.filter_std[i] : T(0),
+          g.sh + 3 * gs::kShCoefficients * i,
+          g.sh_degree,
+          g.antialiased};
+}
+
+// The gradient of one GaussianRow, and the screen-space gradients that drive densification.
+template <typename T>
+struct GaussianRowGrad {
+  Vec3T<T> mean;
+  T log_scale[3];
+  T quat[4];
+  T opacity_logit;
+  T sh[3 * gs::kShCoefficients];
+  T viewspace[2], viewspace_abs[2];
 };
 
 template <typename T>
@@ -69,20 +106,21 @@ IESRGS_HD T stable_filtered_det(const Projection<T>& p, T h) {
   return det_cov + h * (p.cov.xx + p.cov.yy) + h * h;
 }
 
-// Fills p for Gaussian i; false when it is culled (behind the near plane or degenerate).
+// Fills p for one Gaussian (or one per lane); false where it is culled (behind the near plane or
+// degenerate). Branch-free, so that it runs on SIMD packs: culled lanes compute garbage that the
+// result masks.
 template <typename T>
-IESRGS_HD bool project(const GaussianParams<T>& g, int i, const RasterCamera<T>& cam,
-                       Projection<T>& p) {
+IESRGS_HD hd::Mask<T> project(const GaussianRow<T>& g, const RasterCamera<T>& cam,
+                              Projection<T>& p) {
   const Mat3T<T> w = camera_rotation(cam);
-  const Vec3T<T> mean{g.means[3 * i], g.means[3 * i + 1], g.means[3 * i + 2]};
-  p.view = mul(w, mean) + Vec3T<T>{cam.translation[0], cam.translation[1], cam.translation[2]};
+  p.view = mul(w, g.mean) + Vec3T<T>{cam.translation[0], cam.translation[1], cam.translation[2]};
   const T z = p.view.z;
-  if (!(z > T(kNearPlane))) return false;  // also culls a non-finite mean
+  hd::Mask<T> visible = z > T(kNearPlane);  // also culls a non-finite mean
 
-  for (int k = 0; k < 3; ++k) p.scale[k] = hd::exp(g.log_scales[3 * i + k]);
-  p.opacity3d = gs::filter3d(p.scale, g.filter_std ? g.filter_std[i] : T(0), p.var);
-  p.sigmoid = T(1) / (T(1) + hd::exp(-g.opacity_logits[i]));
-  p.rot = quat_to_rotation(g.quats + 4 * i);
+  for (int k = 0; k < 3; ++k) p.scale[k] = hd::exp(g.log_scale[k]);
+  p.opacity3d = gs::filter3d(p.scale, g.filter_std, p.var);
+  p.sigmoid = T(1) / (T(1) + hd::exp(-g.opacity_logit));
+  p.rot = quat_to_rotation(g.quat);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) {
       T s = 0;
@@ -98,8 +136,8 @@ IESRGS_HD bool project(const GaussianParams<T>& g, int i, const RasterCamera<T>&
   p.clamped_y = ry < -lim_y || ry > lim_y;
   p.tx = hd::min(lim_x, hd::max(-lim_x, rx)) * z;
   p.ty = hd::min(lim_y, hd::max(-lim_y, ry)) * z;
-  const T j[2][3] = {{cam.fx / z, 0, -cam.fx * p.tx / (z * z)},
-                     {0, cam.fy / z, -cam.fy * p.ty / (z * z)}};
+  const T j[2][3] = {{cam.fx / z, T(0), -cam.fx * p.tx / (z * z)},
+                     {T(0), cam.fy / z, -cam.fy * p.ty / (z * z)}};
   for (int r = 0; r < 2; ++r)
     for (int c = 0; c < 3; ++c)
       p.jw[r][c] = j[r][0] * w.m[0][c] + j[r][1] * w.m[1][c] + j[r][2] * w.m[2][c];
@@ -114,19 +152,21 @@ IESRGS_HD bool project(const GaussianParams<T>& g, int i, const RasterCamera<T>&
     }
   p.cov = {cov[0][0], cov[0][1], cov[1][1]};
   p.opacity2d = gs::filter2d(p.cov, g.antialiased, p.filtered);
-  if (!(det(p.filtered) > T(0))) return false;
+  visible = visible && det(p.filtered) > T(0);
   p.conic = inverse(p.filtered);
   p.filtered_det = stable_filtered_det(p, T(gs::filter2d_variance(g.antialiased)));
-  return true;
+  return visible;
+}
+
+// Fills p for Gaussian i of g; false when it is culled.
+template <typename T>
+IESRGS_HD bool project(const GaussianParams<T>& g, int i, const RasterCamera<T>& cam,
+                       Projection<T>& p) {
+  return project(gaussian_row(g, i), cam, p);
 }
 
 template <typename T>
-IESRGS_HD Vec3T<T> view_direction(const GaussianParams<T>& g, int i, const RasterCamera<T>& cam) {
-  return Vec3T<T>{g.means[3 * i], g.means[3 * i + 1], g.means[3 * i + 2]} - camera_center(cam);
-}
-
-template <typename T>
-IESRGS_HD Splat<T> make_splat(const GaussianParams<T>& g, int i, const RasterCamera<T>& cam,
+IESRGS_HD Splat<T> make_splat(const GaussianRow<T>& g, const RasterCamera<T>& cam,
                               const Projection<T>& p) {
   Splat<T> s;
   s.x = cam.fx * p.view.x / p.view.z + cam.cx;
@@ -135,24 +175,29 @@ IESRGS_HD Splat<T> make_splat(const GaussianParams<T>& g, int i, const RasterCam
   s.conic_xy = p.conic.xy;
   s.conic_yy = p.conic.yy;
   s.opacity = p.sigmoid * p.opacity3d * p.opacity2d;
-  gs::sh_to_color(g.sh_degree, g.sh + 3 * gs::kShCoefficients * i, view_direction(g, i, cam),
-                  s.color);
+  gs::sh_to_color(g.sh_degree, g.sh, g.mean - camera_center(cam), s.color);
   s.depth = p.view.z;
   // opacity * exp(-q / 2) >= 1/255 iff q <= 2 ln(255 opacity); a relative margin keeps rounding
   // at the border on the safe side.
   const T level = T(2) * hd::log(s.opacity / T(kMinAlpha));
-  s.cutoff = level > T(0) ? level * T(1.001) + T(1e-3) : T(0);
+  s.cutoff = hd::select(level > T(0), level * T(1.001) + T(1e-3), T(0));
   s.conic_det = T(1) / p.filtered_det;
   return s;
+}
+
+template <typename T>
+IESRGS_HD Splat<T> make_splat(const GaussianParams<T>& g, int i, const RasterCamera<T>& cam,
+                              const Projection<T>& p) {
+  return make_splat(gaussian_row(g, i), cam, p);
 }
 
 // Bounding box of the pixels whose alpha can reach 1/255. Unlike 3DGS's fixed 3 sigma this drops
 // nothing the blending would keep (as gsplat), and shrinks faint splats. Empty when nothing can
 // be seen.
 template <typename T>
-IESRGS_HD PixelRect splat_rect(const Splat<T>& s, const Projection<T>& p, int width, int height) {
+IESRGS_HD PixelRect splat_rect(const Splat<T>& s, const Sym2<T>& filtered, int width, int height) {
   PixelRect rect{0, 0, 0, 0};
-  const T hx = hd::sqrt(s.cutoff * p.filtered.xx), hy = hd::sqrt(s.cutoff * p.filtered.yy);
+  const T hx = hd::sqrt(s.cutoff * filtered.xx), hy = hd::sqrt(s.cutoff * filtered.yy);
   // A diverged Gaussian (non-finite center or extent) covers nothing instead of every pixel.
   if (!(s.cutoff > T(0)) || !hd::isfinite(s.x + hx) || !hd::isfinite(s.y + hy)) return rect;
   // Pixel i has its center at i + 0.5; clamp to the image in floating point before converting,
@@ -168,35 +213,31 @@ IESRGS_HD PixelRect splat_rect(const Splat<T>& s, const Projection<T>& p, int wi
 
 // Screen-space radius in pixels reported for densification (the larger half-extent of the box).
 template <typename T>
-IESRGS_HD int splat_radius(const Splat<T>& s, const Projection<T>& p) {
-  return int(hd::ceil(hd::sqrt(s.cutoff * hd::max(p.filtered.xx, p.filtered.yy))));
+IESRGS_HD int splat_radius(const Splat<T>& s, const Sym2<T>& filtered) {
+  return int(hd::ceil(hd::sqrt(s.cutoff * hd::max(filtered.xx, filtered.yy))));
 }
 
-// Accumulates into grads (row i of every array) the gradient of Gaussian i given the gradient of
-// its splat. Viewspace gradients are written, not accumulated.
+// The gradient of one Gaussian (or one per lane) given the gradient of its splat; false where it
+// is culled, which gets no gradient. Branch-free like project().
 template <typename T>
-IESRGS_HD void project_backward(const GaussianParams<T>& g, int i, const RasterCamera<T>& cam,
-                                const SplatGrad<T>& ds, const GaussianGrads<T>& grads) {
+IESRGS_HD hd::Mask<T> project_backward(const GaussianRow<T>& g, const RasterCamera<T>& cam,
+                                       const SplatGrad<T>& ds, GaussianRowGrad<T>& out) {
   Projection<T> p;
-  if (!project(g, i, cam, p)) return;
+  const hd::Mask<T> visible = project(g, cam, p);
   const T z = p.view.z;
   const Mat3T<T> w = camera_rotation(cam);
 
   // Screen position and depth.
   Vec3T<T> dview{ds.x * cam.fx / z, ds.y * cam.fy / z,
                  ds.depth - (ds.x * cam.fx * p.view.x + ds.y * cam.fy * p.view.y) / (z * z)};
-  if (grads.viewspace) {
-    grads.viewspace[2 * i] = ds.x * T(0.5) * T(cam.width);
-    grads.viewspace[2 * i + 1] = ds.y * T(0.5) * T(cam.height);
-  }
-  if (grads.viewspace_abs) {
-    grads.viewspace_abs[2 * i] = ds.abs_x * T(0.5) * T(cam.width);
-    grads.viewspace_abs[2 * i + 1] = ds.abs_y * T(0.5) * T(cam.height);
-  }
+  out.viewspace[0] = ds.x * T(0.5) * T(cam.width);
+  out.viewspace[1] = ds.y * T(0.5) * T(cam.height);
+  out.viewspace_abs[0] = ds.abs_x * T(0.5) * T(cam.width);
+  out.viewspace_abs[1] = ds.abs_y * T(0.5) * T(cam.height);
 
   // Opacity = sigmoid * opacity3d * opacity2d.
   const T dsigmoid = ds.opacity * p.opacity3d * p.opacity2d;
-  grads.opacity_logits[i] += dsigmoid * p.sigmoid * (T(1) - p.sigmoid);
+  out.opacity_logit = dsigmoid * p.sigmoid * (T(1) - p.sigmoid);
   const T dopacity3d = ds.opacity * p.sigmoid * p.opacity2d;
   const T dopacity2d = ds.opacity * p.sigmoid * p.opacity3d;
 
@@ -233,14 +274,10 @@ IESRGS_HD void project_backward(const GaussianParams<T>& g, int i, const RasterC
              T(2) * cam.fx * p.tx / z3 * dj[0][2] + T(2) * cam.fy * p.ty / z3 * dj[1][2];
   const T dtx = -cam.fx / z2 * dj[0][2], dty = -cam.fy / z2 * dj[1][2];
   // tx = z * clamp(x / z): the clamped ratio is constant, so tx then scales with z.
-  if (p.clamped_x)
-    dview.z += dtx * p.tx / z;
-  else
-    dview.x += dtx;
-  if (p.clamped_y)
-    dview.z += dty * p.ty / z;
-  else
-    dview.y += dty;
+  dview.z += hd::select(p.clamped_x, dtx * p.tx / z, T(0));
+  dview.x += hd::select(p.clamped_x, T(0), dtx);
+  dview.z += hd::select(p.clamped_y, dty * p.ty / z, T(0));
+  dview.y += hd::select(p.clamped_y, T(0), dty);
 
   // sigma = R diag(var) R^T: dvar_k = (R^T dsigma R)_kk, dR = 2 dsigma R diag(var).
   T dvar[3];
@@ -257,24 +294,43 @@ IESRGS_HD void project_backward(const GaussianParams<T>& g, int i, const RasterC
       for (int b = 0; b < 3; ++b) s += dsigma.m[a][b] * p.rot.m[b][k];
       drot.m[a][k] = T(2) * s * p.var[k];
     }
-  T dlog_scale[3];
-  gs::filter3d_backward(p.scale, g.filter_std ? g.filter_std[i] : T(0), dvar, dopacity3d,
-                        dlog_scale);
-  for (int k = 0; k < 3; ++k) grads.log_scales[3 * i + k] += dlog_scale[k];
-  T dq[4];
-  quat_to_rotation_backward(g.quats + 4 * i, drot, dq);
-  for (int k = 0; k < 4; ++k) grads.quats[4 * i + k] += dq[k];
+  gs::filter3d_backward(p.scale, g.filter_std, dvar, dopacity3d, out.log_scale);
+  quat_to_rotation_backward(g.quat, drot, out.quat);
 
   // Color through the spherical harmonics and the view direction.
-  Vec3T<T> dmean = mul_transposed(w, dview);
-  T dsh[3 * gs::kShCoefficients];
-  gs::sh_to_color_backward(g.sh_degree, g.sh + 3 * gs::kShCoefficients * i,
-                           view_direction(g, i, cam), ds.color, dsh, dmean);
+  out.mean = mul_transposed(w, dview);
+  gs::sh_to_color_backward(g.sh_degree, g.sh, g.mean - camera_center(cam), ds.color, out.sh,
+                           out.mean);
+  return visible;
+}
+
+// Adds d to row i of every array of grads; the viewspace gradients are written, not added.
+template <typename T>
+IESRGS_HD void add_row_grad(const GaussianRowGrad<T>& d, int i, const GaussianGrads<T>& grads) {
+  if (grads.viewspace) {
+    grads.viewspace[2 * i] = d.viewspace[0];
+    grads.viewspace[2 * i + 1] = d.viewspace[1];
+  }
+  if (grads.viewspace_abs) {
+    grads.viewspace_abs[2 * i] = d.viewspace_abs[0];
+    grads.viewspace_abs[2 * i + 1] = d.viewspace_abs[1];
+  }
+  grads.opacity_logits[i] += d.opacity_logit;
+  for (int k = 0; k < 3; ++k) grads.log_scales[3 * i + k] += d.log_scale[k];
+  for (int k = 0; k < 4; ++k) grads.quats[4 * i + k] += d.quat[k];
   for (int k = 0; k < 3 * gs::kShCoefficients; ++k)
-    grads.sh[3 * gs::kShCoefficients * i + k] += dsh[k];
-  grads.means[3 * i] += dmean.x;
-  grads.means[3 * i + 1] += dmean.y;
-  grads.means[3 * i + 2] += dmean.z;
+    grads.sh[3 * gs::kShCoefficients * i + k] += d.sh[k];
+  grads.means[3 * i] += d.mean.x;
+  grads.means[3 * i + 1] += d.mean.y;
+  grads.means[3 * i + 2] += d.mean.z;
+}
+
+// Adds to grads the gradient of Gaussian i given the gradient of its splat.
+template <typename T>
+IESRGS_HD void project_backward(const GaussianParams<T>& g, int i, const RasterCamera<T>& cam,
+                                const SplatGrad<T>& ds, const GaussianGrads<T>& grads) {
+  GaussianRowGrad<T> d;
+  if (project_backward(gaussian_row(g, i), cam, ds, d)) add_row_grad(d, i, grads);
 }
 
 }  // namespace iesrgs::raster

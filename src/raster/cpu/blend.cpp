@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "raster/cpu/blend.hpp"
 #include "raster/cpu/pack.hpp"
+#include "raster/cpu/variants.hpp"
 
 namespace iesrgs::raster::cpu::IESRGS_CPU_ISA_NAMESPACE {
 

@@ -1,5 +1,5 @@
 #pragma once
-// Run-time choice of the instruction-set variant (isa.hpp) of the CPU blend passes.
+// Run-time choice of the instruction-set variant (isa.hpp) of the CPU projection and blend passes.
 #include <string>
 
 namespace iesrgs::raster::cpu {
@@ -13,10 +13,10 @@ enum class Isa {
 Isa parse_isa(const std::string& name, const std::string& source);
 // Whether this build has the variant and this CPU can run it.
 bool isa_supported(Isa isa);
-// The variant that later blend passes run: at first the best supported one, or the one that the
+// The variant that later passes run: at first the best supported one, or the one that the
 // environment variable IESRGS_CPU_ISA names (throws Error where it is unknown or unsupported).
 Isa active_isa();
-// Makes later blend passes, in every thread, run `isa`; throws Error where it is unsupported.
+// Makes later passes, in every thread, run `isa`; throws Error where it is unsupported.
 void set_active_isa(Isa isa);
 // The variant's name and vector width, e.g. "avx2 (32-byte packs)".
 std::string describe_isa(Isa isa);

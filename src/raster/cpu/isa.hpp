@@ -1,12 +1,13 @@
 #pragma once
-// Instruction-set variants of the CPU pixel kernels. A portable x86-64 build compiles the blend
-// passes twice, with its own flags (SSE2) and with -mavx2 -mfma (IESRGS_CPU_ISA_AVX2 defined), and
-// dispatch.hpp picks one per call. Each compilation defines everything of its own, inline and
-// template functions included, in the namespace IESRGS_CPU_ISA_NAMESPACE: were a function of the
-// AVX2 compilation to share its name with one of the baseline, the linker could keep the AVX2
-// copy for both, and the baseline path would fault on CPUs without AVX2. Functions of other
-// headers (the standard library's, raster/*.hpp) must be inlined there, so the variant is only
-// built when optimizing, and the build checks the AVX2 object's symbols
+// Instruction-set variants of the CPU kernels. A portable x86-64 build compiles the projection and
+// blend passes twice, with its own flags (SSE2) and with -mavx2 -mfma (IESRGS_CPU_ISA_AVX2
+// defined), and dispatch.hpp picks one per call. Each compilation defines everything of its own,
+// inline and template functions included, in the namespace IESRGS_CPU_ISA_NAMESPACE: were a
+// function of the AVX2 compilation to share its name with one of the baseline, the linker could
+// keep the AVX2 copy for both, and the baseline path would fault on CPUs without AVX2. Functions of
+// other headers (the standard library's, raster/*.hpp) must be inlined there, or take a type of
+// the variant's namespace (the projection's lanes.hpp), so the variant is only built when
+// optimizing, and the build checks the AVX2 object's symbols
 // (check_isa_symbols.cmake).
 
 #if defined(IESRGS_CPU_ISA_AVX2)
