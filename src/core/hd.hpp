@@ -15,31 +15,25 @@ namespace iesrgs::hd {
 // The math functions are templates so that the CPU kernels can specialize them for their SIMD
 // lanes (raster/cpu/lanes.hpp) and run the same formulas on several Gaussians at once.
 #if defined(__CUDACC__)
-#define IESRGS_HD_MATH ::
+#define IESRGS_HD_MATH(name) \
+  template <typename T>      \
+  IESRGS_HD T name(T x) {    \
+    return ::name(x);        \
+  }
+using ::isfinite;
 #else
-#define IESRGS_HD_MATH std::
+#define IESRGS_HD_MATH(name) \
+  template <typename T>      \
+  IESRGS_HD T name(T x) {    \
+    return std::name(x);     \
+  }
+using std::isfinite;
 #endif
-using IESRGS_HD_MATH isfinite;
-template <typename T>
-IESRGS_HD T ceil(T x) {
-  return IESRGS_HD_MATH ceil(x);
-}
-template <typename T>
-IESRGS_HD T floor(T x) {
-  return IESRGS_HD_MATH floor(x);
-}
-template <typename T>
-IESRGS_HD T exp(T x) {
-  return IESRGS_HD_MATH exp(x);
-}
-template <typename T>
-IESRGS_HD T log(T x) {
-  return IESRGS_HD_MATH log(x);
-}
-template <typename T>
-IESRGS_HD T sqrt(T x) {
-  return IESRGS_HD_MATH sqrt(x);
-}
+IESRGS_HD_MATH(ceil)
+IESRGS_HD_MATH(floor)
+IESRGS_HD_MATH(exp)
+IESRGS_HD_MATH(log)
+IESRGS_HD_MATH(sqrt)
 #undef IESRGS_HD_MATH
 
 template <typename T>

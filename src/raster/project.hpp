@@ -2,7 +2,8 @@
 // Projection of one Gaussian to a screen-space splat, and its backward pass, following 3DGS
 // (EWA splatting with the Jacobian clamped at 1.3 x tan(fov / 2)) with Mip-Splatting's 3D
 // smoothing filter and 2D mip filter, or 3DGS's dilation for models trained without it. The
-// backward pass recomputes the forward intermediates.
+// backward pass recomputes the forward intermediates. T is float or double on one Gaussian, or a
+// pack of floats with one Gaussian per SIMD lane (raster/cpu/lanes.hpp), hence no branch on data.
 #include "gs/mip_filter.hpp"
 #include "gs/sh.hpp"
 #include "raster/geometry.hpp"
@@ -40,7 +41,7 @@ struct Projection {
 };
 
 // One Gaussian's parameters as the projection reads them: row i of GaussianParams in place, or,
-// with T a SIMD pack, one Gaussian per lane (raster/cpu/project.cpp).
+// with T a SIMD pack, one Gaussian per lane (raster/cpu/project_packs.cpp).
 template <typename T>
 struct GaussianRow {
   Vec3T<T> mean;

@@ -3,7 +3,6 @@
 // instantiated in an AVX2 compilation.
 #include <atomic>
 #include <cstdlib>
-#include <type_traits>
 
 #include "core/error.hpp"
 #include "raster/cpu/dispatch.hpp"
@@ -54,15 +53,6 @@ BlendPasses<T> passes([[maybe_unused]] Isa isa) {
   return baseline::blend_passes<T>();
 }
 
-template <typename T>
-ProjectPasses<T> projection([[maybe_unused]] Isa isa) {
-#if defined(IESRGS_CPU_AVX2_VARIANT)
-  if constexpr (std::is_same_v<T, float>)
-    if (isa == Isa::kAvx2) return avx2::project_passes<float>();
-#endif
-  return baseline::project_passes<T>();
-}
-
 }  // namespace
 
 Isa parse_isa(const std::string& name, const std::string& source) {
@@ -88,16 +78,11 @@ std::string describe_isa(Isa isa) {
   return fmt::format("{} ({}-byte packs)", isa_name(isa), passes<float>(isa).pack_bytes);
 }
 
-template <typename T>
-void project_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam, Splat<T>* splats,
-                     PixelRect* rects, int32_t* radii) {
-  projection<T>(active_isa()).forward(g, cam, splats, rects, radii);
-}
-
-template <typename T>
-void project_backward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
-                      const SplatGrad<T>* splat_grads, const GaussianGrads<T>& grads) {
-  projection<T>(active_isa()).backward(g, cam, splat_grads, grads);
+ProjectPacks active_project_packs() {
+#if defined(IESRGS_CPU_AVX2_VARIANT)
+  if (active_isa() == Isa::kAvx2) return avx2::project_packs();
+#endif
+  return baseline::project_packs();
 }
 
 template <typename T>
@@ -115,14 +100,6 @@ void blend_backward(RasterFrame<T>& frame, const T* dimage, const T* dalpha, con
   passes<T>(active_isa()).backward(frame, dimage, dalpha, ddepth);
 }
 
-template void project_forward(const GaussianParams<float>&, const RasterCamera<float>&,
-                              Splat<float>*, PixelRect*, int32_t*);
-template void project_forward(const GaussianParams<double>&, const RasterCamera<double>&,
-                              Splat<double>*, PixelRect*, int32_t*);
-template void project_backward(const GaussianParams<float>&, const RasterCamera<float>&,
-                               const SplatGrad<float>*, const GaussianGrads<float>&);
-template void project_backward(const GaussianParams<double>&, const RasterCamera<double>&,
-                               const SplatGrad<double>*, const GaussianGrads<double>&);
 template void blend_forward(RasterFrame<float>&, float*, float*, float*);
 template void blend_forward(RasterFrame<double>&, double*, double*, double*);
 template void blend_backward(RasterFrame<float>&, const float*, const float*, const float*);

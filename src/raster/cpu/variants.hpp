@@ -1,18 +1,28 @@
 #pragma once
 // The CPU kernels of each instruction-set variant (isa.hpp), between which kernels.hpp's
-// project_forward, project_backward, blend_forward and blend_backward dispatch.
+// projection and blend passes dispatch.
 #include "raster/frame.hpp"
+#include "raster/project.hpp"
 
 namespace iesrgs::raster::cpu {
 
-template <typename T>
-struct ProjectPasses {
-  // project_forward and project_backward of kernels.hpp.
-  void (*forward)(const GaussianParams<T>& g, const RasterCamera<T>& cam, Splat<T>* splats,
-                  PixelRect* rects, int32_t* radii);
-  void (*backward)(const GaussianParams<T>& g, const RasterCamera<T>& cam,
-                   const SplatGrad<T>* splat_grads, const GaussianGrads<T>& grads);
+// The projection of a pack of Gaussians in SIMD lanes, float only (raster/cpu/project.cpp runs
+// the loops around it).
+struct ProjectPacks {
+  // Gaussians index[0..lanes) of g: their splats, filtered screen-space covariances, and whether
+  // each is visible (the others' splats are undefined).
+  void (*forward)(const GaussianParams<float>& g, const RasterCamera<float>& cam, const int* index,
+                  Splat<float>* splats, Sym2<float>* filtered, bool* visible);
+  // Their gradients from the gradients of their splats, and whether each is visible (the others
+  // get none).
+  void (*backward)(const GaussianParams<float>& g, const RasterCamera<float>& cam,
+                   const SplatGrad<float>* splat_grads, const int* index,
+                   GaussianRowGrad<float>* grads, bool* visible);
+  int lanes;  // Gaussians per pack
 };
+
+// The packs of the variant that dispatch.hpp makes active.
+ProjectPacks active_project_packs();
 
 template <typename T>
 struct BlendPasses {
@@ -22,17 +32,15 @@ struct BlendPasses {
   int pack_bytes;  // SIMD width of the pixel loops
 };
 
-// Defined by the compilations of project.cpp and blend.cpp: the baseline ones always, the AVX2
-// ones where IESRGS_CPU_AVX2_VARIANT is defined.
+// Defined by the compilations of project_packs.cpp and blend.cpp: the baseline ones always, the
+// AVX2 ones where IESRGS_CPU_AVX2_VARIANT is defined.
 namespace baseline {
-template <typename T>
-ProjectPasses<T> project_passes();
+ProjectPacks project_packs();
 template <typename T>
 BlendPasses<T> blend_passes();
 }  // namespace baseline
 namespace avx2 {
-template <typename T>
-ProjectPasses<T> project_passes();
+ProjectPacks project_packs();
 template <typename T>
 BlendPasses<T> blend_passes();
 }  // namespace avx2
