@@ -15,26 +15,23 @@ namespace iesrgs::hd {
 // The math functions are templates so that the CPU kernels can specialize them for their SIMD
 // lanes (raster/cpu/lanes.hpp) and run the same formulas on several Gaussians at once.
 #if defined(__CUDACC__)
-#define IESRGS_HD_MATH(name) \
-  template <typename T>      \
-  IESRGS_HD T name(T x) {    \
-    return ::name(x);        \
-  }
-using ::isfinite;
+#define IESRGS_HD_LIBM ::
 #else
-#define IESRGS_HD_MATH(name) \
-  template <typename T>      \
-  IESRGS_HD T name(T x) {    \
-    return std::name(x);     \
-  }
-using std::isfinite;
+#define IESRGS_HD_LIBM std::
 #endif
+#define IESRGS_HD_MATH(name)       \
+  template <typename T>            \
+  IESRGS_HD T name(T x) {          \
+    return IESRGS_HD_LIBM name(x); \
+  }
+using IESRGS_HD_LIBM isfinite;
 IESRGS_HD_MATH(ceil)
 IESRGS_HD_MATH(floor)
 IESRGS_HD_MATH(exp)
 IESRGS_HD_MATH(log)
 IESRGS_HD_MATH(sqrt)
 #undef IESRGS_HD_MATH
+#undef IESRGS_HD_LIBM
 
 template <typename T>
 IESRGS_HD T min(T a, T b) {
