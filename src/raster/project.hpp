@@ -192,30 +192,53 @@ IESRGS_HD Splat<T> make_splat(const GaussianParams<T>& g, int i, const RasterCam
   return make_splat(gaussian_row(g, i), cam, p);
 }
 
-// Bounding box of the pixels whose alpha can reach 1/255. Unlike 3DGS's fixed 3 sigma this drops
-// nothing the blending would keep (as gsplat), and shrinks faint splats. Empty when nothing can
-// be seen.
 template <typename T>
-IESRGS_HD PixelRect splat_rect(const Splat<T>& s, const Sym2<T>& filtered, int width, int height) {
-  PixelRect rect{0, 0, 0, 0};
+struct SplatBounds {
+  T x0, y0, x1, y1;  // pixels [x0, x1) x [y0, y1), clamped to the image
+  T radius;          // reported for densification: the larger half-extent of the box
+};
+
+// Bounding box of the pixels whose alpha can reach 1/255. Unlike 3DGS's fixed 3 sigma this drops
+// nothing the blending would keep (as gsplat), and shrinks faint splats. All zero where nothing
+// can be seen. Branch-free like project(); splat_rect converts the bounds to ints.
+template <typename T>
+IESRGS_HD void splat_bounds(const Splat<T>& s, const Sym2<T>& filtered, int width, int height,
+                            SplatBounds<T>& b) {
   const T hx = hd::sqrt(s.cutoff * filtered.xx), hy = hd::sqrt(s.cutoff * filtered.yy);
-  // A diverged Gaussian (non-finite center or extent) covers nothing instead of every pixel.
-  if (!(s.cutoff > T(0)) || !hd::isfinite(s.x + hx) || !hd::isfinite(s.y + hy)) return rect;
   // Pixel i has its center at i + 0.5; clamp to the image in floating point before converting,
   // so that a center far off screen cannot overflow an int.
-  const auto clamp = [](T v, int hi) { return int(hd::min(T(hi), hd::max(T(0), v))); };
-  rect.x0 = clamp(hd::ceil(s.x - hx - T(0.5)), width);
-  rect.y0 = clamp(hd::ceil(s.y - hy - T(0.5)), height);
-  rect.x1 = clamp(hd::floor(s.x + hx - T(0.5)) + T(1), width);
-  rect.y1 = clamp(hd::floor(s.y + hy - T(0.5)) + T(1), height);
-  if (rect.empty()) rect = {0, 0, 0, 0};
-  return rect;
+  const auto clamp = [](T v, int hi) { return hd::min(T(hi), hd::max(T(0), v)); };
+  b.x0 = clamp(hd::ceil(s.x - hx - T(0.5)), width);
+  b.y0 = clamp(hd::ceil(s.y - hy - T(0.5)), height);
+  b.x1 = clamp(hd::floor(s.x + hx - T(0.5)) + T(1), width);
+  b.y1 = clamp(hd::floor(s.y + hy - T(0.5)) + T(1), height);
+  b.radius = hd::ceil(hd::max(hx, hy));
+  // A diverged Gaussian (non-finite center or extent) covers nothing instead of every pixel.
+  const auto finite = [](T v) { return T(-INFINITY) < v && v < T(INFINITY); };
+  const auto seen = T(0) < s.cutoff && finite(s.x + hx) && finite(s.y + hy);
+  T* const bounds[] = {&b.x0, &b.y0, &b.x1, &b.y1, &b.radius};
+  for (T* bound : bounds) *bound = hd::select(seen, *bound, T(0));
 }
 
-// Screen-space radius in pixels reported for densification (the larger half-extent of the box).
+// The pixel rectangle and radius of the bounds of a visible splat (one that project() keeps);
+// both zero otherwise, or when the rectangle is empty.
 template <typename T>
-IESRGS_HD int splat_radius(const Splat<T>& s, const Sym2<T>& filtered) {
-  return int(hd::ceil(hd::sqrt(s.cutoff * hd::max(filtered.xx, filtered.yy))));
+IESRGS_HD void splat_rect(bool visible, const SplatBounds<T>& b, PixelRect& rect, int32_t& radius) {
+  rect = {0, 0, 0, 0};
+  radius = 0;
+  if (!visible) return;  // its bounds are undefined
+  const PixelRect r{int32_t(b.x0), int32_t(b.y0), int32_t(b.x1), int32_t(b.y1)};
+  if (r.empty()) return;
+  rect = r;
+  radius = int32_t(b.radius);
+}
+
+template <typename T>
+IESRGS_HD void splat_rect(const Splat<T>& s, const Sym2<T>& filtered, int width, int height,
+                          PixelRect& rect, int32_t& radius) {
+  SplatBounds<T> b;
+  splat_bounds(s, filtered, width, height, b);
+  splat_rect(true, b, rect, radius);
 }
 
 // The gradient of one Gaussian (or one per lane) given the gradient of its splat; false where it

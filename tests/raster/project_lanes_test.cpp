@@ -29,8 +29,7 @@ Projected project_each(const GaussianParams<float>& g, const RasterCamera<float>
     Projection<float> p;
     if (!project(g, i, cam, p)) continue;
     out.splats[i] = make_splat(g, i, cam, p);
-    out.rects[i] = splat_rect(out.splats[i], p.filtered, cam.width, cam.height);
-    if (!out.rects[i].empty()) out.radii[i] = splat_radius(out.splats[i], p.filtered);
+    splat_rect(out.splats[i], p.filtered, cam.width, cam.height, out.rects[i], out.radii[i]);
   }
   return out;
 }

@@ -1,10 +1,10 @@
 #pragma once
 // Floats in SIMD lanes that the scalar formulas of raster/project.hpp accept as their T, so that
 // the CPU projection runs them on a pack of Gaussians at once, one per lane. Every operation rounds
-// as the scalar one does: arithmetic and sqrt are exact IEEE operations on each lane, exp and log
-// call the C library lane by lane, min, max and select keep the scalar NaN behavior, and the
-// variant that includes this compiles without contracting into fused multiply-adds. The lanes give
-// the scalar code's results to the bit.
+// as the scalar one does: arithmetic, sqrt, ceil and floor are exact IEEE operations on each lane,
+// exp and log call the C library lane by lane, min, max and select keep the scalar NaN behavior,
+// and the variant that includes this compiles without contracting into fused multiply-adds. The
+// lanes give the scalar code's results to the bit.
 #include <cmath>
 
 #include "core/hd.hpp"
@@ -85,6 +85,24 @@ inline FloatLanes sqrt<FloatLanes>(FloatLanes x) {
   return FloatLanes((raster::cpu::IESRGS_CPU_ISA_NAMESPACE::Pack<float>)_mm_sqrt_ps((__m128)x.v));
 #else
   return each_lane(x, [](float a) { return std::sqrt(a); });
+#endif
+}
+template <>
+inline FloatLanes ceil<FloatLanes>(FloatLanes x) {
+#if defined(__AVX__)
+  return FloatLanes((raster::cpu::IESRGS_CPU_ISA_NAMESPACE::Pack<float>)_mm256_round_ps(
+      (__m256)x.v, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC));
+#else
+  return each_lane(x, [](float a) { return std::ceil(a); });
+#endif
+}
+template <>
+inline FloatLanes floor<FloatLanes>(FloatLanes x) {
+#if defined(__AVX__)
+  return FloatLanes((raster::cpu::IESRGS_CPU_ISA_NAMESPACE::Pack<float>)_mm256_round_ps(
+      (__m256)x.v, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+#else
+  return each_lane(x, [](float a) { return std::floor(a); });
 #endif
 }
 template <>

@@ -19,13 +19,6 @@ void lane_indices(int first, int lanes, int count, int* index) {
   for (int l = 0; l < lanes; ++l) index[l] = std::min(first + l, count - 1);
 }
 
-template <typename T>
-void set_rect(const Splat<T>& splat, const Sym2<T>& filtered, const RasterCamera<T>& cam,
-              PixelRect& rect, int32_t& radius) {
-  rect = splat_rect(splat, filtered, cam.width, cam.height);
-  radius = rect.empty() ? 0 : splat_radius(splat, filtered);
-}
-
 // Gaussians per block of the backward pass, whose ones with a gradient are packed into lanes.
 constexpr int kBackwardBlock = 256;
 
@@ -38,17 +31,14 @@ void forward_packs(const GaussianParams<float>& g, const RasterCamera<float>& ca
     const int first = pack * packs.lanes;
     int index[kMaxLanes];
     Splat<float> splat[kMaxLanes];
-    Sym2<float> filtered[kMaxLanes];
+    SplatBounds<float> bounds[kMaxLanes];
     bool visible[kMaxLanes];
     lane_indices(first, packs.lanes, g.count, index);
-    packs.forward(g, cam, index, splat, filtered, visible);
+    packs.forward(g, cam, index, splat, bounds, visible);
     for (int l = 0; l < packs.lanes && first + l < g.count; ++l) {
       const int i = first + l;
-      rects[i] = {0, 0, 0, 0};
-      radii[i] = 0;
-      if (!visible[l]) continue;
-      splats[i] = splat[l];
-      set_rect(splat[l], filtered[l], cam, rects[i], radii[i]);
+      splat_rect(visible[l], bounds[l], rects[i], radii[i]);
+      if (visible[l]) splats[i] = splat[l];
     }
   }
 }
@@ -62,7 +52,7 @@ void forward_rows(const GaussianParams<double>& g, const RasterCamera<double>& c
     radii[i] = 0;
     if (!project(g, i, cam, p)) continue;
     splats[i] = make_splat(g, i, cam, p);
-    set_rect(splats[i], p.filtered, cam, rects[i], radii[i]);
+    splat_rect(splats[i], p.filtered, cam.width, cam.height, rects[i], radii[i]);
   }
 }
 

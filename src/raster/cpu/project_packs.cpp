@@ -13,7 +13,7 @@ namespace {
 
 constexpr int kShFloats = 3 * gs::kShCoefficients;
 
-// Number of fields of a struct made of T only (Splat, SplatGrad, Sym2, GaussianRowGrad).
+// Number of fields of a struct made of T only (Splat, SplatGrad, SplatBounds, GaussianRowGrad).
 template <template <typename> class Struct>
 constexpr int field_count() {
   constexpr int n = sizeof(Struct<float>) / sizeof(float);
@@ -100,14 +100,17 @@ struct RowLanes {
 };
 
 void forward_pack(const GaussianParams<float>& g, const RasterCamera<float>& cam, const int* index,
-                  Splat<float>* splats, Sym2<float>* filtered, bool* visible) {
+                  Splat<float>* splats, SplatBounds<float>* bounds, bool* visible) {
   const RasterCamera<FloatLanes> lanes_cam = lanes_camera(cam);
   const RowLanes in(g, index);
   const GaussianRow<FloatLanes> row = in.row();
   Projection<FloatLanes> p;
   scatter_mask(project(row, lanes_cam, p), visible);
-  scatter<Splat>(make_splat(row, lanes_cam, p), splats);
-  scatter<Sym2>(p.filtered, filtered);
+  const Splat<FloatLanes> splat = make_splat(row, lanes_cam, p);
+  SplatBounds<FloatLanes> b;
+  splat_bounds(splat, p.filtered, cam.width, cam.height, b);
+  scatter<Splat>(splat, splats);
+  scatter<SplatBounds>(b, bounds);
 }
 
 void backward_pack(const GaussianParams<float>& g, const RasterCamera<float>& cam,

@@ -9,10 +9,10 @@ namespace iesrgs::raster::cpu {
 // The projection of a pack of Gaussians in SIMD lanes, float only (raster/cpu/project.cpp runs
 // the loops around it).
 struct ProjectPacks {
-  // Gaussians index[0..lanes) of g: their splats, filtered screen-space covariances, and whether
-  // each is visible (the others' splats are undefined).
+  // Gaussians index[0..lanes) of g: their splats, their pixel bounds, and whether each is
+  // visible (the others' splats and bounds are undefined).
   void (*forward)(const GaussianParams<float>& g, const RasterCamera<float>& cam, const int* index,
-                  Splat<float>* splats, Sym2<float>* filtered, bool* visible);
+                  Splat<float>* splats, SplatBounds<float>* bounds, bool* visible);
   // Their gradients from the gradients of their splats, and whether each is visible (the others
   // get none).
   void (*backward)(const GaussianParams<float>& g, const RasterCamera<float>& cam,

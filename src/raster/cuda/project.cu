@@ -21,8 +21,7 @@ __global__ void project_forward_kernel(GaussianParams<float> g, RasterCamera<flo
   if (project(g, i, cam, p)) {
     const Splat<float> s = make_splat(g, i, cam, p);
     splats[i] = s;
-    rect = splat_rect(s, p.filtered, cam.width, cam.height);
-    if (!rect.empty()) radius = splat_radius(s, p.filtered);
+    splat_rect(s, p.filtered, cam.width, cam.height, rect, radius);
   }
   rects[i] = rect;
   radii[i] = radius;
