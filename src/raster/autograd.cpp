@@ -22,44 +22,48 @@ using torch::Tensor;
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
-#ifdef IESRGS_WITH_CUDA
-// CUDA rasterizers whose frames autograd has let go of: their device buffers, grown to the
-// scene, serve the next frames instead of being allocated and freed for each.
-class RasterizerPool {
+// Frames whose autograd graph is gone: their buffers, grown to the scene, serve the next frames
+// instead of being allocated, zeroed and freed for each render (host vectors for the CPU
+// rasterizer, device buffers for the CUDA one).
+template <typename Held>
+class Pool {
  public:
-  std::unique_ptr<cuda::Rasterizer> take() {
+  std::unique_ptr<Held> take() {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (free_.empty()) return std::make_unique<cuda::Rasterizer>();
-    std::unique_ptr<cuda::Rasterizer> rasterizer = std::move(free_.back());
+    if (free_.empty()) return std::make_unique<Held>();
+    std::unique_ptr<Held> held = std::move(free_.back());
     free_.pop_back();
-    return rasterizer;
+    return held;
   }
-  void give_back(std::unique_ptr<cuda::Rasterizer> rasterizer) {
+  void give_back(std::unique_ptr<Held> held) {
     std::lock_guard<std::mutex> lock(mutex_);
-    free_.push_back(std::move(rasterizer));
+    free_.push_back(std::move(held));
   }
 
  private:
   std::mutex mutex_;
-  std::vector<std::unique_ptr<cuda::Rasterizer>> free_;
+  std::vector<std::unique_ptr<Held>> free_;
 };
 
-RasterizerPool& rasterizer_pool() {
-  static RasterizerPool* pool = new RasterizerPool;  // never destroyed: outlives the CUDA context
+template <typename Held>
+Pool<Held>& pool() {
+  static Pool<Held>* pool = new Pool<Held>;  // never destroyed: outlives the CUDA context
   return *pool;
 }
-#endif
 
 // Keeps the forward pass's frame alive until backward, inside the autograd context: the CPU
 // rasterizer's frame, or the CUDA rasterizer that holds the frame's device buffers.
 struct FrameHolder : torch::CustomClassHolder {
-  RasterFrame<float> frame;
+  std::unique_ptr<RasterFrame<float>> frame;
 #ifdef IESRGS_WITH_CUDA
   std::unique_ptr<cuda::Rasterizer> device;
-  ~FrameHolder() override {
-    if (device) rasterizer_pool().give_back(std::move(device));
-  }
 #endif
+  ~FrameHolder() override {
+    if (frame) pool<RasterFrame<float>>().give_back(std::move(frame));
+#ifdef IESRGS_WITH_CUDA
+    if (device) pool<cuda::Rasterizer>().give_back(std::move(device));
+#endif
+  }
 };
 
 void check_tensor(const Tensor& t, const char* name, std::initializer_list<int64_t> shape,
@@ -142,11 +146,14 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
                                        depth.data_ptr<float>(), radii.data_ptr<int32_t>()};
 #ifdef IESRGS_WITH_CUDA
     if (means.is_cuda()) {
-      holder->device = rasterizer_pool().take();
+      holder->device = pool<cuda::Rasterizer>().take();
       holder->device->forward(g, camera, background.data(), targets);
     } else
 #endif
-      rasterize_forward(g, camera, background.data(), holder->frame, targets);
+    {
+      holder->frame = pool<RasterFrame<float>>().take();
+      rasterize_forward(g, camera, background.data(), *holder->frame, targets);
+    }
     ctx->save_for_backward({means, log_scales, quats, logits, sh, filter_std});
     ctx->saved_data["frame"] = c10::IValue::make_capsule(holder);
     ctx->saved_data["sh_degree"] = sh_degree;
@@ -187,7 +194,7 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
       holder->device->backward(g, pixel_grads, grads);
     else
 #endif
-      rasterize_backward(g, holder->frame, pixel_grads, grads);
+      rasterize_backward(g, *holder->frame, pixel_grads, grads);
     return {dmeans,     dlog_scales, dquats,   dlogits,  dsh,      Tensor(), dprobe,
             dabs_probe, Tensor(),    Tensor(), Tensor(), Tensor(), Tensor()};
   }
