@@ -2,6 +2,7 @@
 // Random Gaussian scenes and cameras for the rasterizer tests.
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "gs/sh.hpp"
@@ -130,9 +131,12 @@ struct KernelRender {
   RasterFrame<T> frame;
 };
 
+// `frame` may hold an earlier render's buffers, as the frames that autograd takes from its pool.
 template <typename T>
-KernelRender<T> kernel_render(const Scene<T>& s, const Camera& cam, const T background[3]) {
+KernelRender<T> kernel_render(const Scene<T>& s, const Camera& cam, const T background[3],
+                              RasterFrame<T> frame = {}) {
   KernelRender<T> r;
+  r.frame = std::move(frame);
   const size_t plane = size_t(cam.intrinsics.width) * cam.intrinsics.height;
   r.image.assign(3 * plane, T(-1));
   r.alpha.assign(plane, T(-1));

@@ -2,6 +2,7 @@
 #include <omp.h>
 
 #include <limits>
+#include <tuple>
 #include <utility>
 
 #include "core/error.hpp"
@@ -151,22 +152,49 @@ TEST(RasterForward, SupersampledRenderMatchesAfterBoxFilter) {
   EXPECT_LT(mean, 5e-4);
 }
 
-// Means and SH gradients of a uniform image gradient, rendered and differentiated with `threads`.
-std::vector<float> render_and_differentiate(const Scene<float>& s, const Camera& cam, int threads,
-                                            KernelRender<float>& r) {
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(threads);
-  const float bg[3] = {0, 0, 0};
-  r = kernel_render(s, cam, bg);
+// Means and SH gradients of a uniform image gradient on the render r of s.
+std::vector<float> differentiate(const Scene<float>& s, KernelRender<float>& r) {
   const std::vector<float> dimage(r.image.size(), 1.f);
   const size_t n = s.count();
   std::vector<float> dmeans(3 * n), dscales(3 * n), dquats(4 * n), dlogits(n), dsh(48 * n);
   rasterize_backward(s.params(), r.frame, PixelGrads<float>{dimage.data()},
                      GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(),
                                           dlogits.data(), dsh.data()});
-  omp_set_num_threads(saved);
   dmeans.insert(dmeans.end(), dsh.begin(), dsh.end());
   return dmeans;
+}
+
+// The same, rendered and differentiated with `threads`.
+std::vector<float> render_and_differentiate(const Scene<float>& s, const Camera& cam, int threads,
+                                            KernelRender<float>& r) {
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  const float bg[3] = {0, 0, 0};
+  r = kernel_render(s, cam, bg);
+  std::vector<float> grads = differentiate(s, r);
+  omp_set_num_threads(saved);
+  return grads;
+}
+
+TEST(RasterForward, AReusedFrameRendersAsAFreshOne) {
+  // Frames go back to a pool and serve later renders of any size: nothing of the scene before,
+  // larger or smaller, may leak into the next one, forward or backward.
+  const Camera big = posed_test_camera(80, 64), small = test_camera(24, 20);
+  const Scene<float> many = random_scene(big, 300, 3, 11).cast<float>();
+  const Scene<float> few = random_scene(small, 12, 1, 4).cast<float>();
+  const float bg[3] = {0.2f, 0.4f, 0.6f};
+  for (const auto& [before, before_cam, s, cam] :
+       {std::tuple{&many, &big, &few, &small}, std::tuple{&few, &small, &many, &big}}) {
+    KernelRender<float> earlier = kernel_render(*before, *before_cam, bg);
+    differentiate(*before, earlier);
+    KernelRender<float> reused = kernel_render(*s, *cam, bg, std::move(earlier.frame));
+    KernelRender<float> fresh = kernel_render(*s, *cam, bg);
+    EXPECT_EQ(reused.image, fresh.image);
+    EXPECT_EQ(reused.alpha, fresh.alpha);
+    EXPECT_EQ(reused.depth, fresh.depth);
+    EXPECT_EQ(reused.radii, fresh.radii);
+    EXPECT_EQ(differentiate(*s, reused), differentiate(*s, fresh));
+  }
 }
 
 TEST(RasterForward, DeterministicAcrossRunsAndThreadCounts) {
