@@ -24,7 +24,6 @@ namespace iesrgs::hd {
   IESRGS_HD T name(T x) {          \
     return IESRGS_HD_LIBM name(x); \
   }
-using IESRGS_HD_LIBM isfinite;
 IESRGS_HD_MATH(ceil)
 IESRGS_HD_MATH(floor)
 IESRGS_HD_MATH(exp)
