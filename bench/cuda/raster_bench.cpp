@@ -137,12 +137,13 @@ void bench_ssim(int width, int height, int frames) {
   iesrgs::cuda::DeviceArray<float> x(std::vector<float>(shape.values(), 0.4f));
   iesrgs::cuda::DeviceArray<float> y(std::vector<float>(shape.values(), 0.6f));
   iesrgs::cuda::DeviceArray<float> weight(std::vector<float>(shape.pixels(), 1.f));
-  iesrgs::cuda::DeviceArray<float> partials, grad;
+  iesrgs::cuda::DeviceArray<float> partials, grad, mean;
   partials.reserve(loss::ssim_partials_size(shape));
   grad.reserve(shape.values());
+  mean.reserve(1);
   loss::cuda::Ssim ssim;
   const double ms = time_frames(frames, [&] {
-    ssim.forward(x.data(), y.data(), shape, nullptr, partials.data());
+    ssim.forward(x.data(), y.data(), shape, nullptr, partials.data(), mean.data());
     ssim.backward(x.data(), y.data(), shape, partials.data(), weight.data(), grad.data());
     check(cudaDeviceSynchronize(), "ssim");
   });

@@ -80,19 +80,24 @@ class SsimFunction : public torch::autograd::Function<SsimFunction> {
     const ImageShape shape = chw_shape(x, "ssim");
     at::Tensor map = at::empty({shape.height, shape.width}, x.options());
     at::Tensor partials = at::empty({int64_t(ssim_partials_size(shape))}, x.options());
-    const double mean = with_scalar_type(x, [&](auto zero) {
+    const at::Tensor mean = with_scalar_type(x, [&](auto zero) {
       using T = decltype(zero);
 #ifdef IESRGS_WITH_CUDA
       if constexpr (std::is_same_v<T, float>)
-        if (x.is_cuda())
-          return device_ssim().forward(x.data_ptr<float>(), y.data_ptr<float>(), shape,
-                                       map.data_ptr<float>(), partials.data_ptr<float>());
+        if (x.is_cuda()) {  // the mean stays on the device: no wait for the GPU
+          at::Tensor out = at::empty({}, x.options());
+          device_ssim().forward(x.data_ptr<float>(), y.data_ptr<float>(), shape,
+                                map.data_ptr<float>(), partials.data_ptr<float>(),
+                                out.data_ptr<float>());
+          return out;
+        }
 #endif
-      return ssim<T>(x.data_ptr<T>(), y.data_ptr<T>(), shape, map.data_ptr<T>(),
-                     partials.data_ptr<T>());
+      return at::scalar_tensor(ssim<T>(x.data_ptr<T>(), y.data_ptr<T>(), shape, map.data_ptr<T>(),
+                                       partials.data_ptr<T>()),
+                               x.options());
     });
     ctx->save_for_backward({x, y, partials});
-    return {at::scalar_tensor(mean, x.options()), map};
+    return {mean, map};
   }
 
   // Upstream gradients arrive materialized (zeros for an unused output).

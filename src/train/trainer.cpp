@@ -213,7 +213,9 @@ double Trainer::step(int64_t iteration) {
   if (iteration % config_.sh_increase_every == 0 && model_.active_sh_degree < config_.max_sh_degree)
     ++model_.active_sh_degree;
   std::vector<gs::ViewStatistics> view_stats;
-  double total = 0;
+  // Summed where the losses are and read once per step: on a GPU each read waits for the device.
+  torch::Tensor sum =
+      torch::zeros({}, torch::TensorOptions().dtype(torch::kFloat64).device(device_));
   for (int v : pick_views()) {
     const TrainView& view = setup_.train_views[size_t(v)];
     const auto probe_options = torch::TensorOptions().device(device_).requires_grad(true);
@@ -227,9 +229,10 @@ double Trainer::step(int64_t iteration) {
                     : photometric_loss(render.image, view.target, config_.dssim_weight);
     // Backward per view: the gradient of the sum without holding K render graphs at once.
     loss.backward();
-    total += loss.item<double>();
+    sum += loss.detach().to(torch::kFloat64);
     view_stats.push_back({probes.grad.grad(), probes.abs_grad.grad(), render.radii});
   }
+  const double total = sum.item<double>();
   if (!std::isfinite(total)) fail_diverged(iteration, total);
   if (iteration < config_.densify_until) stats_.accumulate(view_stats);
   optimizer_->step(model_);

@@ -113,6 +113,10 @@ __global__ void forward_columns(ImageShape shape, Taps w, const float* moments, 
   if ((threadIdx.y * blockDim.x + threadIdx.x) % 32 == 0 && total != 0) atomicAdd(sum, total);
 }
 
+__global__ void write_mean(const double* sum, double count, float* mean) {
+  *mean = float(*sum / count);
+}
+
 // The weighted partials blurred along the row.
 __global__ void backward_rows(ImageShape shape, Taps w, const float* partials, const float* weight,
                               float* blurred) {
@@ -158,8 +162,8 @@ __global__ void backward_columns(const float* x, const float* y, ImageShape shap
 
 }  // namespace
 
-double Ssim::forward(const float* x, const float* y, const ImageShape& shape, float* map,
-                     float* partials) {
+void Ssim::forward(const float* x, const float* y, const ImageShape& shape, float* map,
+                   float* partials, float* mean) {
   check_shape(shape, "ssim");
   const Taps w = taps();
   float* moments = planes_.reserve(kMomentPlanes * shape.values());
@@ -167,12 +171,8 @@ double Ssim::forward(const float* x, const float* y, const ImageShape& shape, fl
   check(cudaMemsetAsync(sum, 0, sizeof(double), stream_), "cudaMemset");
   forward_rows<<<grid(shape, shape.channels), kBlock, 0, stream_>>>(x, y, shape, w, moments);
   forward_columns<<<grid(shape, 1), kBlock, 0, stream_>>>(shape, w, moments, map, partials, sum);
+  write_mean<<<1, 1, 0, stream_>>>(sum, double(shape.values()), mean);
   check(cudaGetLastError(), "ssim");
-  double total = 0;
-  check(cudaMemcpyAsync(&total, sum, sizeof total, cudaMemcpyDeviceToHost, stream_),
-        "copy of the SSIM sum");
-  check(cudaStreamSynchronize(stream_), "ssim");
-  return total / double(shape.values());
 }
 
 void Ssim::backward(const float* x, const float* y, const ImageShape& shape, const float* partials,

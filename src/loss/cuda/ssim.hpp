@@ -14,10 +14,11 @@ class Ssim {
   // Work is queued on `stream` (the default stream when null).
   explicit Ssim(CUstream_st* stream = nullptr) : stream_(stream) {}
 
-  // As loss::ssim: the mean SSIM of x against y; map (H x W) and partials
-  // (ssim_partials_size(shape)) are filled when non-null. Waits for the stream.
-  double forward(const float* x, const float* y, const ImageShape& shape, float* map,
-                 float* partials);
+  // As loss::ssim: writes the mean SSIM of x against y to the device float `mean`; map (H x W)
+  // and partials (ssim_partials_size(shape)) are filled when non-null. Queues work without
+  // waiting for it, so that a training step does not stop the host once per loss term.
+  void forward(const float* x, const float* y, const ImageShape& shape, float* map, float* partials,
+               float* mean);
   // As loss::ssim_backward: adds to grad_x the gradient of sum_p weight[p] * map[p].
   void backward(const float* x, const float* y, const ImageShape& shape, const float* partials,
                 const float* weight, float* grad_x);
