@@ -121,7 +121,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
       "(medians)\n",
       n, drawn, args.width, args.height, frame.bins.entry_count(), omp_get_max_threads(),
       args.repeat.iterations);
-  fmt::print("blend kernels: {}\n", cpu::describe_isa(cpu::active_isa()));
+  fmt::print("blend kernels: {}\n", cpu::describe_isa(cpu_isa::active()));
   fmt::print("forward: {:.1f} ms\n", median(forward));
   fmt::print("forward+backward: {:.1f} ms\n", total.wall_ms);
   fmt::print("  projection: {:.1f} ms\n", median(project));

@@ -1,4 +1,4 @@
-// The instruction-set variants of the CPU blend passes agree, and the variant can be chosen.
+// The instruction-set variants of the CPU projection and blend passes agree.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -6,22 +6,13 @@
 
 #include "raster/cpu/dispatch.hpp"
 #include "raster_test_scene.hpp"
-#include "support/expect_error.hpp"
+#include "support/active_isa.hpp"
 
 namespace iesrgs::raster::testkit {
 namespace {
 
 using cpu::Isa;
-
-// Blend passes run `isa` while this lives, then the variant that was active before.
-class ActiveIsa {
- public:
-  explicit ActiveIsa(Isa isa) : saved_(cpu::active_isa()) { cpu::set_active_isa(isa); }
-  ~ActiveIsa() { cpu::set_active_isa(saved_); }
-
- private:
-  Isa saved_;
-};
+using testing::ActiveIsa;
 
 // A render and every gradient of a fixed random linear loss of it.
 template <typename T>
@@ -82,7 +73,7 @@ void expect_variants_agree(const Camera& cam, unsigned seed) {
 }
 
 TEST(RasterCpuIsa, Avx2AgreesWithBaselineOnRandomScenes) {
-  if (!cpu::isa_supported(Isa::kAvx2))
+  if (!cpu_isa::supported(Isa::kAvx2))
     GTEST_SKIP() << "no AVX2 variant: not built (native, Debug or non-x86 build) or no CPU support";
   EXPECT_EQ(cpu::describe_isa(Isa::kAvx2), "avx2 (32-byte packs)");
   // Odd sizes exercise partial packs and border tiles.
@@ -95,18 +86,8 @@ TEST(RasterCpuIsa, Avx2AgreesWithBaselineOnRandomScenes) {
   }
 }
 
-TEST(RasterCpuIsa, BaselineCanAlwaysBeChosen) {
-  EXPECT_TRUE(cpu::isa_supported(Isa::kBaseline));
-  const ActiveIsa active(Isa::kBaseline);
-  EXPECT_EQ(cpu::active_isa(), Isa::kBaseline);
+TEST(RasterCpuIsa, BaselineIsDescribedWithItsPackWidth) {
   EXPECT_EQ(cpu::describe_isa(Isa::kBaseline).rfind("baseline (", 0), 0u);
-}
-
-TEST(RasterCpuIsa, NamesParseAndUnknownOnesAreErrors) {
-  EXPECT_EQ(cpu::parse_isa("baseline", "test"), Isa::kBaseline);
-  EXPECT_EQ(cpu::parse_isa("avx2", "test"), Isa::kAvx2);
-  EXPECT_EQ(testing::error_message([] { cpu::parse_isa("sse9", "IESRGS_CPU_ISA"); }),
-            "IESRGS_CPU_ISA: unknown instruction set 'sse9' (expected baseline or avx2)");
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "raster/cpu/kernels.hpp"
 #include "raster/project.hpp"
 #include "raster_test_scene.hpp"
+#include "support/active_isa.hpp"
 
 namespace iesrgs::raster::testkit {
 namespace {
@@ -37,10 +38,8 @@ Projected project_each(const GaussianParams<float>& g, const RasterCamera<float>
 Projected project_passes(Isa isa, const GaussianParams<float>& g, const RasterCamera<float>& cam) {
   Projected out{std::vector<Splat<float>>(g.count), std::vector<PixelRect>(g.count),
                 std::vector<int32_t>(g.count, -1)};
-  const Isa saved = cpu::active_isa();
-  cpu::set_active_isa(isa);
+  const testing::ActiveIsa active(isa);
   cpu::project_forward(g, cam, out.splats.data(), out.rects.data(), out.radii.data());
-  cpu::set_active_isa(saved);
   return out;
 }
 
@@ -89,7 +88,7 @@ void expect_passes_match_scalar(const Scene<float>& scene, const Camera& camera,
 
   int visible = 0;
   for (Isa isa : {Isa::kBaseline, Isa::kAvx2}) {
-    if (!cpu::isa_supported(isa)) continue;
+    if (!cpu_isa::supported(isa)) continue;
     SCOPED_TRACE(cpu::describe_isa(isa));
     const Projected lanes = project_passes(isa, g, cam);
     EXPECT_EQ(lanes.radii, reference.radii);
@@ -102,10 +101,10 @@ void expect_passes_match_scalar(const Scene<float>& scene, const Camera& camera,
       }
     }
     Grads grads = zero_grads(g.count);
-    const Isa saved = cpu::active_isa();
-    cpu::set_active_isa(isa);
-    cpu::project_backward(g, cam, splat_grads.data(), view(grads));
-    cpu::set_active_isa(saved);
+    {
+      const testing::ActiveIsa active(isa);
+      cpu::project_backward(g, cam, splat_grads.data(), view(grads));
+    }
     for (size_t k = 0; k < grads.size(); ++k)
       EXPECT_EQ(
           std::memcmp(grads[k].data(), reference_grads[k].data(), grads[k].size() * sizeof(float)),

@@ -2,7 +2,8 @@
 // forward pass, back to front in the backward pass) visits only the pixels its cut-off ellipse
 // covers, a SIMD pack at a time, with the per-pixel state of the tile in structure-of-arrays
 // buffers. The backward pass recomputes each splat's alphas instead of storing per-pixel lists.
-// Compiled once per instruction-set variant (isa.hpp), each into its own namespace.
+// Compiled once per instruction-set variant (core/cpu_isa_variant.hpp), each into its own
+// namespace.
 #include <algorithm>
 #include <cmath>
 

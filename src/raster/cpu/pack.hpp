@@ -4,12 +4,12 @@
 // the compilation's vector unit: 16 bytes (SSE2, the baseline of portable x86-64 builds: four
 // float lanes), 32 bytes where it targets AVX2 (the AVX2 variant, or -DIESRGS_NATIVE=ON on such a
 // machine). Double packs let the same kernels run in double for the gradient checks. Everything
-// here depends on the width, hence lives in the variant's namespace (isa.hpp).
+// here depends on the width, hence lives in the variant's namespace (core/cpu_isa_variant.hpp).
 #include <cstdint>
 #include <cstring>
 
+#include "core/cpu_isa_variant.hpp"
 #include "raster/blend_math.hpp"
-#include "raster/cpu/isa.hpp"
 
 namespace iesrgs::raster::cpu::IESRGS_CPU_ISA_NAMESPACE {
 

@@ -1,7 +1,8 @@
 // The projection of a pack of Gaussians at once, one per SIMD lane: the formulas of
 // raster/project.hpp on FloatLanes (lanes.hpp), with the results of the scalar code to the bit.
-// Compiled once per instruction-set variant (isa.hpp), each into its own namespace, and without
-// fused multiply-adds (CMakeLists.txt); project.cpp runs the loops around it.
+// Compiled once per instruction-set variant (core/cpu_isa_variant.hpp), each into its own
+// namespace, and without fused multiply-adds (CMakeLists.txt); project.cpp runs the loops around
+// it.
 #include <cstring>
 
 #include "raster/cpu/lanes.hpp"

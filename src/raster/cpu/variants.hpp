@@ -1,6 +1,6 @@
 #pragma once
-// The CPU kernels of each instruction-set variant (isa.hpp), between which kernels.hpp's
-// projection and blend passes dispatch.
+// The CPU kernels of each instruction-set variant (core/cpu_isa_variant.hpp), between which
+// kernels.hpp's projection and blend passes dispatch.
 #include "raster/frame.hpp"
 #include "raster/project.hpp"
 

@@ -1,6 +1,6 @@
 # Fails when the AVX2 compilation of the CPU kernels (OBJECT) defines a weak symbol outside its
 # own namespace: the linker keeps one copy of each weak symbol for the whole program, so baseline
-# code could end up running an AVX2-compiled copy (see isa.hpp). Usage:
+# code could end up running an AVX2-compiled copy (see cpu_isa_variant.hpp). Usage:
 #   cmake -DNM=<nm> -DOBJECT=<object file> -P check_isa_symbols.cmake
 execute_process(COMMAND ${NM} --defined-only --demangle ${OBJECT} OUTPUT_VARIABLE symbols
                 RESULT_VARIABLE status)
