@@ -9,6 +9,14 @@
 #else
 #define IESRGS_HD inline
 #endif
+// Inlined at every optimization level, for the functions that an instruction-set variant of the
+// CPU kernels calls with plain scalars: a copy of its own would share the baseline's name
+// (core/cpu_isa_variant.hpp).
+#if defined(__CUDACC__)
+#define IESRGS_HD_ALWAYS_INLINE __host__ __device__ __forceinline__
+#else
+#define IESRGS_HD_ALWAYS_INLINE inline __attribute__((always_inline))
+#endif
 
 namespace iesrgs::hd {
 

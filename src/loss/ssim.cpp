@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
+#include "core/cpu_isa.hpp"
 #include "loss/ssim_point.hpp"
+#include "loss/ssim_rows.hpp"
 
 namespace iesrgs::loss {
 namespace {
@@ -33,16 +36,15 @@ const Window<T>& window() {
   return instance;
 }
 
-// out[x] = sum_k tap[k] * rows[k][x]. The taps run innermost, fully unrolled, so that the sums
-// stay in registers while the loop over x is vectorized.
+// The row loops of the active instruction-set variant; double runs the baseline's.
 template <typename T>
-void blur(const T* tap, const T* const* rows, int width, T* __restrict out) {
-  for (int x = 0; x < width; ++x) {
-    T sum = 0;
-#pragma GCC unroll 16
-    for (int k = 0; k < kSsimWindow; ++k) sum += tap[k] * rows[k][x];
-    out[x] = sum;
+SsimRows<T> active_rows() {
+  if constexpr (std::is_same_v<T, float>) {
+#if defined(IESRGS_CPU_AVX2_VARIANT)
+    if (cpu_isa::active() == cpu_isa::Isa::kAvx2) return avx2::ssim_rows<float>();
+#endif
   }
+  return baseline::ssim_rows<T>();
 }
 
 // Row-pass results of the image rows that the column pass of one output row needs, indexed by
@@ -118,59 +120,14 @@ PaddedSpan padded_span(const ImageShape& shape, const PixelBox& box) {
   return {first, last - first, first - (box.col0 - kRadius)};
 }
 
-// Window statistics of one channel along one row: means of x and y, spread (sum of the two
-// variances) and covariance.
-template <typename T>
-struct MomentRows {
-  T* mean_x;
-  T* mean_y;
-  T* spread;
-  T* cross;
-};
-
-// Weighted statistics of the samples xs[k][x], ys[k][x] (k over the window taps), each the mean of
-// a sub-window with its own spread and covariance spreads[k][x], crosses[k][x] (unused when the
-// samples are single pixels). By the law of total variance the spread of the whole window is that
-// of the sub-windows plus that of their means. Computing it from deviations rather than as
-// E[x^2] - E[x]^2 keeps float SSIM within ~1e-6 of float64 in flat regions, where that
-// cancellation, divided by C2 = 9e-4, costs ~1e-4.
-template <bool kSubWindows, typename T>
-void combine_moments(const T* tap, const T* const* xs, const T* const* ys, const T* const* spreads,
-                     const T* const* crosses, int width, MomentRows<T> out) {
-  for (int x = 0; x < width; ++x) {
-    T mean_x = 0, mean_y = 0, spread = 0, cross = 0;
-#pragma GCC unroll 16
-    for (int k = 0; k < kSsimWindow; ++k) {
-      mean_x += tap[k] * xs[k][x];
-      mean_y += tap[k] * ys[k][x];
-    }
-#pragma GCC unroll 16
-    for (int k = 0; k < kSsimWindow; ++k) {
-      const T dx = xs[k][x] - mean_x, dy = ys[k][x] - mean_y;
-      spread += tap[k] * (dx * dx + dy * dy);
-      cross += tap[k] * dx * dy;
-    }
-    if constexpr (kSubWindows) {
-#pragma GCC unroll 16
-      for (int k = 0; k < kSsimWindow; ++k) {
-        spread += tap[k] * spreads[k][x];
-        cross += tap[k] * crosses[k][x];
-      }
-    }
-    out.mean_x[x] = mean_x;
-    out.mean_y[x] = mean_y;
-    out.spread[x] = spread;
-    out.cross[x] = cross;
-  }
-}
-
 // The forward pass over the pixels of one box: map and partials there, nothing elsewhere.
 template <typename T>
 class ForwardBox {
  public:
-  ForwardBox(const T* x, const T* y, const ImageShape& shape, const PixelBox& box, T* map,
-             T* partials)
-      : x_(x),
+  ForwardBox(const SsimRows<T>& rows, const T* x, const T* y, const ImageShape& shape,
+             const PixelBox& box, T* map, T* partials)
+      : rows_(rows),
+        x_(x),
         y_(y),
         shape_(shape),
         box_(box),
@@ -217,7 +174,7 @@ class ForwardBox {
       xs[k] = padded_x_.data() + k;
       ys[k] = padded_y_.data() + k;
     }
-    combine_moments<false, T>(window<T>().tap, xs, ys, nullptr, nullptr, width_, ring_rows(r));
+    rows_.moments(window<T>().tap, xs, ys, width_, ring_rows(r));
   }
 
   double column_pass(int r, int c) {
@@ -226,21 +183,14 @@ class ForwardBox {
     for (int plane = 0; plane < kMomentPlanes; ++plane) ring_.column(r, plane, rows[plane]);
     T* s = stats_.data();
     const MomentRows<T> stats{s, s + width, s + 2 * width, s + 3 * width};
-    combine_moments<true, T>(window<T>().tap, rows[0], rows[1], rows[2], rows[3], width, stats);
+    rows_.sub_window_moments(window<T>().tap, rows[0], rows[1], rows[2], rows[3], width, stats);
 
     // Value then the kPartialPlanes derivatives, one row each.
     T* values = points_.data();
     T* d_mean = values + width;
     T* d_square = d_mean + width;
     T* d_cross = d_square + width;
-    for (int x = 0; x < width; ++x) {
-      const SsimPoint<T> p =
-          ssim_point(stats.mean_x[x], stats.mean_y[x], stats.spread[x], stats.cross[x]);
-      values[x] = p.value;
-      d_mean[x] = p.d_mean;
-      d_square[x] = p.d_square;
-      d_cross[x] = p.d_cross;
-    }
+    rows_.points(stats, width, values, d_mean, d_square, d_cross);
     if (partials_) {
       const size_t offset = row_offset(shape_, c, r) + box_.col0;
       for (int plane = 0; plane < kPartialPlanes; ++plane)
@@ -257,6 +207,7 @@ class ForwardBox {
     return sum;
   }
 
+  SsimRows<T> rows_;
   const T* x_;
   const T* y_;
   ImageShape shape_;
@@ -276,9 +227,10 @@ class ForwardBox {
 template <typename T>
 class BackwardBox {
  public:
-  BackwardBox(const T* x, const T* y, const ImageShape& shape, const PixelBox& box,
-              const T* partials, const T* weight, T* grad_x)
-      : x_(x),
+  BackwardBox(const SsimRows<T>& rows, const T* x, const T* y, const ImageShape& shape,
+              const PixelBox& box, const T* partials, const T* weight, T* grad_x)
+      : rows_(rows),
+        x_(x),
         y_(y),
         shape_(shape),
         box_(box),
@@ -313,7 +265,7 @@ class BackwardBox {
       for (int x = 0; x < span_.count; ++x) in_image[x] = weight[x] * inv_channels * partial[x];
       const T* rows[kSsimWindow];
       for (int k = 0; k < kSsimWindow; ++k) rows[k] = padded + k;
-      blur(window<T>().tap, rows, width_, ring_.row(r, plane));
+      rows_.blur(window<T>().tap, rows, width_, ring_.row(r, plane));
     }
   }
 
@@ -322,19 +274,17 @@ class BackwardBox {
     for (int plane = 0; plane < kPartialPlanes; ++plane) {
       const T* rows[kSsimWindow];
       ring_.column(r, plane, rows);
-      blur(window<T>().tap, rows, width, blurred_.data() + size_t(plane) * width);
+      rows_.blur(window<T>().tap, rows, width, blurred_.data() + size_t(plane) * width);
     }
     const T* d_mean = blurred_.data();
     const T* d_square = d_mean + width;
     const T* d_cross = d_square + width;
     const size_t offset = row_offset(shape_, c, r) + box_.col0;
-    const T* x = x_ + offset;
-    const T* y = y_ + offset;
-    T* grad_x = grad_x_ + offset;
-    for (int i = 0; i < width; ++i)
-      grad_x[i] += d_mean[i] + 2 * x[i] * d_square[i] + y[i] * d_cross[i];
+    rows_.add_gradient(d_mean, d_square, d_cross, x_ + offset, y_ + offset, width,
+                       grad_x_ + offset);
   }
 
+  SsimRows<T> rows_;
   const T* x_;
   const T* y_;
   ImageShape shape_;
@@ -395,8 +345,9 @@ double ssim_in(const T* x, const T* y, const ImageShape& shape, const std::vecto
                T* map, T* partials) {
   check_shape(shape, "ssim");
   std::vector<double> box_sums(boxes.size(), 0.0);
+  const SsimRows<T> rows = active_rows<T>();
   for_each_box(boxes, [&](int64_t i, const PixelBox& box) {
-    box_sums[i] = ForwardBox<T>(x, y, shape, box, map, partials).run();
+    box_sums[i] = ForwardBox<T>(rows, x, y, shape, box, map, partials).run();
   });
   double sum = 0;
   for (double s : box_sums) sum += s;
@@ -408,8 +359,9 @@ void ssim_backward_in(const T* x, const T* y, const ImageShape& shape,
                       const std::vector<PixelBox>& boxes, const T* partials, const T* weight,
                       T* grad_x) {
   check_shape(shape, "ssim_backward");
+  const SsimRows<T> rows = active_rows<T>();
   for_each_box(boxes, [&](int64_t, const PixelBox& box) {
-    BackwardBox<T>(x, y, shape, box, partials, weight, grad_x).run();
+    BackwardBox<T>(rows, x, y, shape, box, partials, weight, grad_x).run();
   });
 }
 

@@ -31,7 +31,7 @@ struct SsimPoint {
 
 // From the window means of x and y, their spread (sum of the two variances) and covariance.
 template <typename T>
-IESRGS_HD SsimPoint<T> ssim_point(T mean_x, T mean_y, T spread, T cross) {
+IESRGS_HD_ALWAYS_INLINE SsimPoint<T> ssim_point(T mean_x, T mean_y, T spread, T cross) {
   const T c1 = T(kSsimC1), c2 = T(kSsimC2);
   const T a1 = 2 * mean_x * mean_y + c1, a2 = 2 * cross + c2;
   const T b1 = mean_x * mean_x + mean_y * mean_y + c1, b2 = spread + c2;

@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <utility>
 #include <vector>
 
 #include "loss/loss_test_support.hpp"
+#include "support/active_isa.hpp"
 #include "support/expect_error.hpp"
 
 namespace iesrgs::loss {
@@ -168,6 +170,48 @@ TEST(Ssim, FloatBackwardMatchesDouble) {
   // In the flat blocks the gradient is a difference of terms ~1/C2 larger than itself, which
   // float resolves to a few 1e-5 of the largest entry (as torch's float autograd does).
   EXPECT_LT(loss_testing::relative_max_error({gradient.begin(), gradient.end()}, expected), 1e-4);
+}
+
+// Mean, map, partials and gradient of a float SSIM pass under one instruction-set variant.
+struct FloatPass {
+  double mean;
+  std::vector<float> map, partials, gradient;
+};
+
+FloatPass float_pass(cpu_isa::Isa isa, const ImagePair& pair, const std::vector<double>& weight) {
+  const testing::ActiveIsa active(isa);
+  const std::vector<float> x = to_float(pair.x), y = to_float(pair.y);
+  FloatPass out{0, std::vector<float>(pair.shape.pixels()),
+                std::vector<float>(ssim_partials_size(pair.shape)),
+                std::vector<float>(pair.shape.values(), 0.5f)};
+  out.mean = ssim<float>(x.data(), y.data(), pair.shape, out.map.data(), out.partials.data());
+  ssim_backward<float>(x.data(), y.data(), pair.shape, out.partials.data(), to_float(weight).data(),
+                       out.gradient.data());
+  return out;
+}
+
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+// The variants differ in vector width only: no fused multiply-adds, and each pixel's sums run in
+// the same order, so their results are the same to the bit.
+TEST(Ssim, InstructionSetVariantsGiveTheSameBits) {
+  if (!cpu_isa::supported(cpu_isa::Isa::kAvx2))
+    GTEST_SKIP() << "no AVX2 variant: not built (native, Debug or non-x86 build) or no CPU support";
+  for (const ImageShape shape :
+       {ImageShape{67, 45, 3}, ImageShape{5, 30, 1}, ImageShape{200, 9, 3}}) {
+    SCOPED_TRACE(::testing::Message()
+                 << shape.width << "x" << shape.height << "x" << shape.channels);
+    const ImagePair pair = textured_pair(shape, 11);
+    const std::vector<double> weight = random_values(shape.pixels(), 12, -1.0, 1.0);
+    const FloatPass base = float_pass(cpu_isa::Isa::kBaseline, pair, weight);
+    const FloatPass avx2 = float_pass(cpu_isa::Isa::kAvx2, pair, weight);
+    EXPECT_EQ(avx2.mean, base.mean);
+    EXPECT_TRUE(same_bits(avx2.map, base.map));
+    EXPECT_TRUE(same_bits(avx2.partials, base.partials));
+    EXPECT_TRUE(same_bits(avx2.gradient, base.gradient));
+  }
 }
 
 TEST(Ssim, BackwardAddsToTheGradient) {
