@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/validators.hpp"
+#include "core/cpu_isa.hpp"
 #include "core/math.hpp"
 #include "gs/benchmark_model.hpp"
 #include "gs/optimizer.hpp"
@@ -148,6 +149,7 @@ void run_ssim_bench(const SsimBenchArgs& args) {
   });
   fmt::print("image: {}x{} RGB, {} threads, {} iterations (medians)\n", args.width, args.height,
              omp_get_max_threads(), args.repeat.iterations);
+  fmt::print("row loops: {}\n", cpu_isa::name(cpu_isa::active()));
   fmt::print("forward (with partials): {:.2f} ms\n", forward.wall_ms);
   fmt::print("forward+backward: {:.2f} ms ({:.1f} Mpixel/s)\n", total.wall_ms,
              double(shape.pixels()) / total.wall_ms / 1e3);

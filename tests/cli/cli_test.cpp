@@ -87,6 +87,7 @@ TEST(Cli, BenchModesPrintTheirTimings) {
   const CliRun ssim = iesrgs("bench ssim --width 40 --height 24 --iterations 2 --threads 1");
   EXPECT_EQ(ssim.status, 0) << ssim.output;
   EXPECT_TRUE(contains(ssim.output, "image: 40x24 RGB, 1 threads")) << ssim.output;
+  EXPECT_TRUE(contains(ssim.output, "row loops: ")) << ssim.output;
   EXPECT_TRUE(contains(ssim.output, "forward+backward: ")) << ssim.output;
   const CliRun adam = iesrgs("bench adam --gaussians 100 --iterations 2");
   EXPECT_EQ(adam.status, 0) << adam.output;
