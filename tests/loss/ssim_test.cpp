@@ -5,12 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <utility>
 #include <vector>
 
 #include "loss/loss_test_support.hpp"
 #include "support/active_isa.hpp"
+#include "support/compare.hpp"
 #include "support/expect_error.hpp"
 
 namespace iesrgs::loss {
@@ -190,10 +190,6 @@ FloatPass float_pass(cpu_isa::Isa isa, const ImagePair& pair, const std::vector<
   return out;
 }
 
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
-
 // The variants differ in vector width only: no fused multiply-adds, and each pixel's sums run in
 // the same order, so their results are the same to the bit.
 TEST(Ssim, InstructionSetVariantsGiveTheSameBits) {
@@ -208,9 +204,9 @@ TEST(Ssim, InstructionSetVariantsGiveTheSameBits) {
     const FloatPass base = float_pass(cpu_isa::Isa::kBaseline, pair, weight);
     const FloatPass avx2 = float_pass(cpu_isa::Isa::kAvx2, pair, weight);
     EXPECT_EQ(avx2.mean, base.mean);
-    EXPECT_TRUE(same_bits(avx2.map, base.map));
-    EXPECT_TRUE(same_bits(avx2.partials, base.partials));
-    EXPECT_TRUE(same_bits(avx2.gradient, base.gradient));
+    EXPECT_TRUE(testing::same_bits(avx2.map, base.map));
+    EXPECT_TRUE(testing::same_bits(avx2.partials, base.partials));
+    EXPECT_TRUE(testing::same_bits(avx2.gradient, base.gradient));
   }
 }
 

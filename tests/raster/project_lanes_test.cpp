@@ -10,6 +10,7 @@
 #include "raster/project.hpp"
 #include "raster_test_scene.hpp"
 #include "support/active_isa.hpp"
+#include "support/compare.hpp"
 
 namespace iesrgs::raster::testkit {
 namespace {
@@ -106,10 +107,7 @@ void expect_passes_match_scalar(const Scene<float>& scene, const Camera& camera,
       cpu::project_backward(g, cam, splat_grads.data(), view(grads));
     }
     for (size_t k = 0; k < grads.size(); ++k)
-      EXPECT_EQ(
-          std::memcmp(grads[k].data(), reference_grads[k].data(), grads[k].size() * sizeof(float)),
-          0)
-          << "gradient group " << k;
+      EXPECT_TRUE(testing::same_bits(grads[k], reference_grads[k])) << "gradient group " << k;
   }
   EXPECT_GT(visible, g.count / 2) << "too few Gaussians on screen to compare";
 }

@@ -2,6 +2,7 @@
 // Distances between arrays of results, for comparing two implementations of one kernel.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 namespace iesrgs::testing {
@@ -26,6 +27,12 @@ inline double relative_l2_error(const std::vector<float>& a, const std::vector<f
     norm += double(b[i]) * b[i];
   }
   return norm > 0 ? std::sqrt(diff / norm) : std::sqrt(diff);
+}
+
+// Whether two implementations agree to the bit: same size, same bytes.
+template <typename T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
 }  // namespace iesrgs::testing
