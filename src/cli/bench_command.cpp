@@ -1,6 +1,7 @@
 // iesrgs bench: times the CPU hot paths on synthetic inputs. `raster`: the rasterizer forward,
-// forward+backward and each stage; `ssim`: the SSIM loss kernel with its backward, as a training
-// step runs it; `adam`: the fused optimizer step over every Gaussian parameter.
+// forward+backward and each stage, also of a trained model from a scene's cameras; `ssim`: the SSIM
+// loss kernel with its backward, as a training step runs it; `adam`: the fused optimizer step over
+// every Gaussian parameter.
 #include <fmt/format.h>
 #include <omp.h>
 #include <torch/torch.h>
@@ -16,10 +17,14 @@
 #include "core/cpu_isa.hpp"
 #include "core/math.hpp"
 #include "gs/benchmark_model.hpp"
+#include "gs/model.hpp"
 #include "gs/optimizer.hpp"
 #include "gs/sh.hpp"
+#include "io/model_file.hpp"
+#include "io/scene.hpp"
 #include "loss/benchmark_image.hpp"
 #include "loss/ssim.hpp"
+#include "raster/autograd.hpp"
 #include "raster/cpu/dispatch.hpp"
 #include "raster/rasterizer.hpp"
 #include "raster/synthetic_scene.hpp"
@@ -36,6 +41,11 @@ struct RepeatArgs {
 struct RasterBenchArgs {
   int gaussians = 100000;
   int width = 800, height = 800;
+  std::string model;  // a trained model to time instead of the synthetic scene
+  std::string scene;  // whose training cameras see it
+  int downscale = 1;
+  double scale = 1;
+  int views = 10;
   RepeatArgs repeat;
 };
 
@@ -83,13 +93,71 @@ Timing time_runs(int iterations, const std::function<void(int)>& work) {
   return {median(wall), 1000.0 * double(std::clock() - cpu_start) / CLOCKS_PER_SEC / iterations};
 }
 
+// Gaussians and the cameras the timed frames see them from, one frame per camera.
+struct RasterWorkload {
+  std::string description;
+  raster::GaussianCloud synthetic;  // owns the arrays of a synthetic scene
+  raster::GaussianTensors trained;  // owns those of a trained model
+  raster::GaussianParams<float> params;
+  std::vector<raster::RasterCamera<float>> cameras;
+};
+
+RasterWorkload synthetic_workload(const RasterBenchArgs& args) {
+  RasterWorkload w;
+  w.cameras = {raster::benchmark_camera(args.width, args.height)};
+  w.synthetic = raster::synthetic_scene(args.gaussians, w.cameras[0], 1);
+  w.params = w.synthetic.params();
+  w.description =
+      fmt::format("synthetic, {} Gaussians, {}x{}", args.gaussians, args.width, args.height);
+  return w;
+}
+
+// A trained model seen from the first training cameras of a scene, as training renders it.
+RasterWorkload trained_workload(const RasterBenchArgs& args) {
+  const gs::GaussianModel model = gs::model_from_splat_cloud(read_model(model_file(args.model)));
+  SceneOptions options;
+  options.downscale = args.downscale;
+  const Scene scene = load_scene(args.scene, options);
+  require_training_views(scene);
+  RasterWorkload w;
+  for (const Camera* camera : scene.split(Split::Train)) {
+    if (int(w.cameras.size()) == args.views) break;
+    w.cameras.push_back(raster::raster_camera<float>(camera->scaled(args.scale)));
+  }
+  w.trained = model.render_tensors();
+  w.params = raster::kernel_params(w.trained);
+  w.description =
+      fmt::format("{}, {} Gaussians, {} training views of {} at {}x{}", args.model, model.size(),
+                  w.cameras.size(), args.scene, w.cameras[0].width, w.cameras[0].height);
+  return w;
+}
+
+// Stage times of one frame, or their sum over the frames of one timed run.
+struct RasterStageTimes {
+  double forward = 0, project = 0, bin = 0, blend = 0, backward = 0;
+  size_t entries = 0, drawn = 0;
+
+  RasterStageTimes& operator+=(const RasterStageTimes& o) {
+    forward += o.forward;
+    project += o.project;
+    bin += o.bin;
+    blend += o.blend;
+    backward += o.backward;
+    entries += o.entries;
+    drawn += o.drawn;
+    return *this;
+  }
+};
+
 void run_raster_bench(const RasterBenchArgs& args) {
   apply(args.repeat);
   using namespace raster;
-  const RasterCamera<float> cam = benchmark_camera(args.width, args.height);
-  const GaussianCloud cloud = synthetic_scene(args.gaussians, cam, 1);
-  const GaussianParams<float> g = cloud.params();
-  const size_t plane = size_t(args.width) * args.height, n = size_t(args.gaussians);
+  const RasterWorkload w = args.model.empty() ? synthetic_workload(args) : trained_workload(args);
+  const GaussianParams<float>& g = w.params;
+  size_t plane = 0;
+  for (const RasterCamera<float>& cam : w.cameras)
+    plane = std::max(plane, size_t(cam.width) * cam.height);
+  const size_t n = size_t(g.count);
   std::vector<float> image(3 * plane), alpha(plane), depth(plane);
   std::vector<int32_t> radii(n);
   // A loss gradient that reaches every output.
@@ -98,8 +166,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
       dsh(3 * gs::kShCoefficients * n), dview(2 * n), dview_abs(2 * n);
   const float background[3] = {1, 1, 1};
   RasterFrame<float> frame;
-  std::vector<double> forward, project, bin, blend, backward;
-  const Timing total = time_runs(args.repeat.iterations, [&](int it) {
+  const auto render_frame = [&](const RasterCamera<float>& cam) {
     const auto start = Clock::now();
     rasterize_forward(g, cam, background, frame,
                       RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
@@ -108,28 +175,43 @@ void run_raster_bench(const RasterBenchArgs& args) {
         g, frame, PixelGrads<float>{dimage.data(), dalpha.data(), ddepth.data()},
         GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(), dlogits.data(),
                              dsh.data(), dview.data(), dview_abs.data()});
-    if (it < 0) return;
-    forward.push_back(forward_ms);
-    project.push_back(frame.timings.project);
-    bin.push_back(frame.timings.bin);
-    blend.push_back(frame.timings.blend);
-    backward.push_back(frame.timings.blend_backward + frame.timings.project_backward);
+    const RasterTimings& t = frame.timings;
+    return RasterStageTimes{
+        forward_ms,
+        t.project,
+        t.bin,
+        t.blend,
+        t.blend_backward + t.project_backward,
+        frame.bins.entry_count(),
+        size_t(std::count_if(radii.begin(), radii.begin() + n, [](int r) { return r > 0; }))};
+  };
+  std::vector<RasterStageTimes> runs;
+  const Timing total = time_runs(args.repeat.iterations, [&](int it) {
+    RasterStageTimes sum;
+    for (const RasterCamera<float>& cam : w.cameras) sum += render_frame(cam);
+    if (it >= 0) runs.push_back(sum);
   });
-  const size_t drawn =
-      size_t(std::count_if(radii.begin(), radii.end(), [](int r) { return r > 0; }));
+  const double frames = double(w.cameras.size());
+  const auto per_frame = [&](double RasterStageTimes::*stage) {
+    std::vector<double> v;
+    for (const RasterStageTimes& r : runs) v.push_back(r.*stage / frames);
+    return median(v);
+  };
+  fmt::print("scene: {}\n", w.description);
   fmt::print(
-      "scene: {} Gaussians ({} drawn), {}x{}, {} tile entries, {} threads, {} iterations "
+      "per frame: {:.0f} Gaussians drawn, {:.0f} tile entries; {} threads, {} iterations "
       "(medians)\n",
-      n, drawn, args.width, args.height, frame.bins.entry_count(), omp_get_max_threads(),
+      double(runs[0].drawn) / frames, double(runs[0].entries) / frames, omp_get_max_threads(),
       args.repeat.iterations);
   fmt::print("blend kernels: {}\n", cpu::describe_isa(cpu_isa::active()));
-  fmt::print("forward: {:.1f} ms\n", median(forward));
-  fmt::print("forward+backward: {:.1f} ms\n", total.wall_ms);
-  fmt::print("  projection: {:.1f} ms\n", median(project));
-  fmt::print("  binning/sort: {:.1f} ms\n", median(bin));
-  fmt::print("  blend: {:.1f} ms\n", median(blend));
-  fmt::print("  backward: {:.1f} ms\n", median(backward));
-  fmt::print("cpu time, forward+backward: {:.1f} ms over all threads (mean)\n", total.cpu_ms);
+  fmt::print("forward: {:.1f} ms\n", per_frame(&RasterStageTimes::forward));
+  fmt::print("forward+backward: {:.1f} ms\n", total.wall_ms / frames);
+  fmt::print("  projection: {:.1f} ms\n", per_frame(&RasterStageTimes::project));
+  fmt::print("  binning/sort: {:.1f} ms\n", per_frame(&RasterStageTimes::bin));
+  fmt::print("  blend: {:.1f} ms\n", per_frame(&RasterStageTimes::blend));
+  fmt::print("  backward: {:.1f} ms\n", per_frame(&RasterStageTimes::backward));
+  fmt::print("cpu time, forward+backward: {:.1f} ms over all threads (mean)\n",
+             total.cpu_ms / frames);
 }
 
 void run_ssim_bench(const SsimBenchArgs& args) {
@@ -189,7 +271,8 @@ void add_image_size(CLI::App* command, int& width, int& height) {
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
-  auto* bench = app.add_subcommand("bench", "Time parts of the system on synthetic inputs");
+  auto* bench = app.add_subcommand(
+      "bench", "Time parts of the system on synthetic inputs or a trained model");
   bench->require_subcommand(1);
 
   auto* raster = bench->add_subcommand("raster", "Time the CPU rasterizer, forward and backward");
@@ -198,6 +281,25 @@ void add_bench_command(CLI::App& app) {
       ->capture_default_str()
       ->check(kNonNegative);
   add_image_size(raster, raster_args->width, raster_args->height);
+  auto* model = raster->add_option("--model", raster_args->model,
+                                   "Time this trained model (output folder, .ply, .spz or .splat) "
+                                   "instead of a synthetic scene");
+  raster
+      ->add_option("--scene", raster_args->scene,
+                   "The scene whose first training cameras see --model, one frame each")
+      ->needs(model);
+  model->needs("--scene");
+  raster->add_option("--downscale", raster_args->downscale, "Cameras at 1/k of the scene's size")
+      ->capture_default_str()
+      ->check(kPositive);
+  raster
+      ->add_option("--scale", raster_args->scale,
+                   "Resolution factor over the cameras' (SR-splatting renders at 4)")
+      ->capture_default_str()
+      ->check(kPositive);
+  raster->add_option("--views", raster_args->views, "Training cameras to render")
+      ->capture_default_str()
+      ->check(kPositive);
   add_repeat_options(raster, raster_args->repeat);
   raster->callback([raster_args] { run_raster_bench(*raster_args); });
 

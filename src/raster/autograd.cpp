@@ -218,4 +218,13 @@ RenderOutput render(const GaussianTensors& gaussians, const RasterCamera<float>&
   return {out[0], out[1], out[2], out[3]};
 }
 
+GaussianParams<float> kernel_params(const GaussianTensors& gaussians) {
+  check_inputs(gaussians, {});
+  for (const Tensor* t : {&gaussians.means, &gaussians.log_scales, &gaussians.quats,
+                          &gaussians.opacity_logits, &gaussians.sh, &gaussians.filter_std})
+    if (t->defined() && !t->is_contiguous()) fail("kernel_params: a tensor is not contiguous");
+  return params_of(gaussians.means, gaussians.log_scales, gaussians.quats, gaussians.opacity_logits,
+                   gaussians.sh, gaussians.filter_std, gaussians.sh_degree, gaussians.antialiased);
+}
+
 }  // namespace iesrgs::raster

@@ -40,4 +40,8 @@ struct ViewspaceProbes {
 RenderOutput render(const GaussianTensors& gaussians, const RasterCamera<float>& camera,
                     const std::array<float, 3>& background, const ViewspaceProbes& probes = {});
 
+// What the kernels read of `gaussians`, whose tensors must be contiguous float32 and outlive it:
+// for calling rasterize_forward and rasterize_backward without autograd (the benchmarks).
+GaussianParams<float> kernel_params(const GaussianTensors& gaussians);
+
 }  // namespace iesrgs::raster

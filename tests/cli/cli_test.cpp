@@ -82,7 +82,7 @@ TEST(Cli, BenchModesPrintTheirTimings) {
   const CliRun raster =
       iesrgs("bench raster --gaussians 200 --width 48 --height 32 --iterations 2");
   EXPECT_EQ(raster.status, 0) << raster.output;
-  EXPECT_TRUE(contains(raster.output, "scene: 200 Gaussians")) << raster.output;
+  EXPECT_TRUE(contains(raster.output, "scene: synthetic, 200 Gaussians, 48x32")) << raster.output;
   EXPECT_TRUE(contains(raster.output, "forward+backward: ")) << raster.output;
   const CliRun ssim = iesrgs("bench ssim --width 40 --height 24 --iterations 2 --threads 1");
   EXPECT_EQ(ssim.status, 0) << ssim.output;
@@ -105,6 +105,9 @@ TEST(Cli, BenchRefusesEmptyWork) {
   const CliRun threads = iesrgs("bench raster --threads -1");
   EXPECT_EQ(threads.status, 105);
   EXPECT_TRUE(contains(threads.output, "--threads: must be at least 0, got -1")) << threads.output;
+  const CliRun alone = iesrgs("bench raster --model nowhere.ply");
+  EXPECT_EQ(alone.status, 107);
+  EXPECT_TRUE(contains(alone.output, "--model requires --scene")) << alone.output;
 }
 
 TEST(Cli, UpscaleWritesOnePngPerImageOfAFolder) {

@@ -66,6 +66,12 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
     EXPECT_EQ(read_image_header(dir / "orbit" / "rgb" / (std::string(frame) + ".png")).width, 32)
         << frame;
 
+  const CliRun bench = iesrgs("bench raster --model " + out + " --scene " + scene +
+                              " --scale 2 --views 3 --iterations 1");
+  ASSERT_EQ(bench.status, 0) << bench.output;
+  EXPECT_TRUE(contains(bench.output, "3 training views of " + scene + " at 64x64")) << bench.output;
+  EXPECT_TRUE(contains(bench.output, "forward+backward: ")) << bench.output;
+
   const auto splat = dir / "scene.splat";
   const CliRun exported = iesrgs("export " + out + " " + splat.string());
   ASSERT_EQ(exported.status, 0) << exported.output;
