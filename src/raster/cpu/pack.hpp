@@ -82,14 +82,6 @@ inline Pack<T> broadcast(T x) {
   return Pack<T>{} + x;
 }
 
-// Pixel-center x offsets of the lanes.
-template <typename T>
-inline Pack<T> lane_centers() {
-  Pack<T> v;
-  for (int i = 0; i < kLanes<T>; ++i) v[i] = T(i) + T(0.5);
-  return v;
-}
-
 template <typename T>
 inline Pack<T> select(Mask<T> m, Pack<T> a, Pack<T> b) {
   return m ? a : b;
