@@ -79,8 +79,6 @@ void rasterize_backward(const GaussianParams<T>& g, RasterFrame<T>& frame,
   if (size_t(g.count) != frame.splats.size())
     fail("rasterizer: backward got {} Gaussians, forward rendered {}", g.count,
          frame.splats.size());
-  for (const GradArray<T>& a : grad_arrays(grads, size_t(g.count)))
-    if (a.data) std::fill_n(a.data, a.size, T(0));
   StageTimer timer;
   cpu::blend_backward(frame, pixel_grads.image, pixel_grads.alpha, pixel_grads.depth);
   frame.timings.blend_backward = timer.lap();

@@ -2,6 +2,7 @@
 // The differentiable Gaussian rasterizer on the CPU: 3DGS tile rasterization with Mip-Splatting's
 // filters. Forward renders color, alpha and depth; backward turns gradients of those images into
 // gradients of every Gaussian parameter. Instantiated for float and double (gradient checks).
+#include <algorithm>
 #include <array>
 
 #include "gs/sh.hpp"
@@ -44,6 +45,13 @@ std::array<GradArray<T>, 7> grad_arrays(const GaussianGrads<T>& grads, size_t n)
            {grads.sh, 3 * gs::kShCoefficients * n},
            {grads.viewspace, 2 * n},
            {grads.viewspace_abs, 2 * n}}};
+}
+
+// Zeroes the gradients of Gaussians [begin, end) of n.
+template <typename T>
+void clear_grads(const GaussianGrads<T>& grads, size_t n, size_t begin, size_t end) {
+  for (const GradArray<T>& a : grad_arrays(grads, n))
+    if (a.data) std::fill(a.data + a.size / n * begin, a.data + a.size / n * end, T(0));
 }
 
 template <typename T>

@@ -152,11 +152,13 @@ TEST(RasterForward, SupersampledRenderMatchesAfterBoxFilter) {
   EXPECT_LT(mean, 5e-4);
 }
 
-// Means and SH gradients of a uniform image gradient on the render r of s.
-std::vector<float> differentiate(const Scene<float>& s, KernelRender<float>& r) {
+// Means and SH gradients of a uniform image gradient on the render r of s, written into arrays
+// that held `stale` before.
+std::vector<float> differentiate(const Scene<float>& s, KernelRender<float>& r, float stale = 0) {
   const std::vector<float> dimage(r.image.size(), 1.f);
   const size_t n = s.count();
-  std::vector<float> dmeans(3 * n), dscales(3 * n), dquats(4 * n), dlogits(n), dsh(48 * n);
+  std::vector<float> dmeans(3 * n, stale), dscales(3 * n, stale), dquats(4 * n, stale),
+      dlogits(n, stale), dsh(48 * n, stale);
   rasterize_backward(s.params(), r.frame, PixelGrads<float>{dimage.data()},
                      GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(),
                                           dlogits.data(), dsh.data()});
@@ -195,6 +197,18 @@ TEST(RasterForward, AReusedFrameRendersAsAFreshOne) {
     EXPECT_EQ(reused.radii, fresh.radii);
     EXPECT_EQ(differentiate(*s, reused), differentiate(*s, fresh));
   }
+}
+
+TEST(RasterBackward, OverwritesWhatTheGradientArraysHeld) {
+  // The training loop hands the backward pass arrays from earlier steps; Gaussians off the view
+  // or hidden must come back zero, not stale.
+  const Camera cam = posed_test_camera(80, 64);
+  const Scene<float> s = random_scene(cam, 300, 3, 7).cast<float>();
+  const float bg[3] = {0, 0, 0};
+  KernelRender<float> r = kernel_render(s, cam, bg);
+  const std::vector<float> clean = differentiate(s, r);
+  EXPECT_EQ(differentiate(s, r, std::numeric_limits<float>::quiet_NaN()), clean);
+  EXPECT_EQ(differentiate(s, r, 42.f), clean);
 }
 
 TEST(RasterForward, DeterministicAcrossRunsAndThreadCounts) {

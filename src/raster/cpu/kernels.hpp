@@ -8,8 +8,8 @@ namespace iesrgs::raster::cpu {
 template <typename T>
 void project_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam, Splat<T>* splats,
                      PixelRect* rects, int32_t* radii);
-// Adds the parameter gradients of every Gaussian from the per-splat gradients. Both projection
-// passes run the active instruction-set variant (dispatch.hpp).
+// Overwrites grads with the parameter gradients of every Gaussian from the per-splat gradients.
+// Both projection passes run the active instruction-set variant (dispatch.hpp).
 template <typename T>
 void project_backward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
                       const SplatGrad<T>* splat_grads, const GaussianGrads<T>& grads);

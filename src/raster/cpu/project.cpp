@@ -7,6 +7,7 @@
 
 #include "raster/cpu/kernels.hpp"
 #include "raster/cpu/variants.hpp"
+#include "raster/rasterizer.hpp"
 
 namespace iesrgs::raster::cpu {
 
@@ -58,7 +59,8 @@ void forward_rows(const GaussianParams<double>& g, const RasterCamera<double>& c
 
 // A Gaussian outside the view, or hidden behind others wherever it falls, has all-zero partials
 // and contributes nothing: skipping it saves recomputing its projection (most of the backward
-// pass on small images, where many Gaussians are hidden).
+// pass on small images, where many Gaussians are hidden). Each block clears its Gaussians'
+// gradients first, in parallel and while they are about to be written.
 void backward_packs(const GaussianParams<float>& g, const RasterCamera<float>& cam,
                     const SplatGrad<float>* splat_grads, const GaussianGrads<float>& grads) {
   const ProjectPacks packs = active_project_packs();
@@ -68,6 +70,7 @@ void backward_packs(const GaussianParams<float>& g, const RasterCamera<float>& c
     int live[kBackwardBlock + kMaxLanes];
     int n = 0;
     const int end = std::min(g.count, (block + 1) * kBackwardBlock);
+    clear_grads(grads, size_t(g.count), size_t(block) * kBackwardBlock, size_t(end));
     for (int i = block * kBackwardBlock; i < end; ++i)
       if (!splat_grads[i].is_zero()) live[n++] = i;
     for (int start = 0; start < n; start += packs.lanes) {
@@ -85,8 +88,10 @@ void backward_packs(const GaussianParams<float>& g, const RasterCamera<float>& c
 void backward_rows(const GaussianParams<double>& g, const RasterCamera<double>& cam,
                    const SplatGrad<double>* splat_grads, const GaussianGrads<double>& grads) {
 #pragma omp parallel for schedule(static)
-  for (int i = 0; i < g.count; ++i)
+  for (int i = 0; i < g.count; ++i) {
+    clear_grads(grads, size_t(g.count), size_t(i), size_t(i) + 1);
     if (!splat_grads[i].is_zero()) project_backward(g, i, cam, splat_grads[i], grads);
+  }
 }
 
 }  // namespace
