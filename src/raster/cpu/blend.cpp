@@ -7,6 +7,7 @@
 // namespace.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "raster/cpu/pack.hpp"
 #include "raster/cpu/variants.hpp"
@@ -262,7 +263,8 @@ uint32_t load_backward_pixels(const RasterFrame<T>& frame, const TileWindow& win
   return last;
 }
 
-// A splat's gradient summed lane-wise over its pixels; reduced across lanes once per splat.
+// A splat's gradient summed lane-wise over its pixels, in SplatGrad's field order; reduced across
+// lanes once per splat.
 template <typename T>
 struct PackedGrad {
   Pack<T> x{}, y{}, conic_xx{}, conic_xy{}, conic_yy{}, opacity{};
@@ -270,16 +272,15 @@ struct PackedGrad {
   Pack<T> depth{}, abs_x{}, abs_y{};
 
   SplatGrad<T> sum() const {
-    return {horizontal_sum<T>(x),
-            horizontal_sum<T>(y),
-            horizontal_sum<T>(conic_xx),
-            horizontal_sum<T>(conic_xy),
-            horizontal_sum<T>(conic_yy),
-            horizontal_sum<T>(opacity),
-            {horizontal_sum<T>(color[0]), horizontal_sum<T>(color[1]), horizontal_sum<T>(color[2])},
-            horizontal_sum<T>(depth),
-            horizontal_sum<T>(abs_x),
-            horizontal_sum<T>(abs_y)};
+    static constexpr int kFields = sizeof(SplatGrad<T>) / sizeof(T);
+    static_assert(sizeof(PackedGrad) == kFields * sizeof(Pack<T>));
+    Pack<T> fields[kFields];
+    std::memcpy(fields, this, sizeof fields);
+    SplatGrad<T> g;
+    T sums[kFields];
+    horizontal_sums(fields, sums);
+    std::memcpy(&g, sums, sizeof g);
+    return g;
   }
 };
 

@@ -5,8 +5,14 @@
 // float lanes), 32 bytes where it targets AVX2 (the AVX2 variant, or -DIESRGS_NATIVE=ON on such a
 // machine). Double packs let the same kernels run in double for the gradient checks. Everything
 // here depends on the width, hence lives in the variant's namespace (core/cpu_isa_variant.hpp).
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
+
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 #include "core/cpu_isa_variant.hpp"
 #include "raster/blend_math.hpp"
@@ -92,6 +98,32 @@ inline T horizontal_sum(Pack<T> v) {
   T sum = 0;
   for (int i = 0; i < kLanes<T>; ++i) sum += v[i];
   return sum;
+}
+
+// sums[k] = horizontal_sum(v[k]) for each of the N packs. With AVX, eight float packs at a time
+// through a transposing tree of horizontal adds: a dozen instructions where lane-by-lane sums
+// take about ten each.
+template <typename T, int N>
+inline void horizontal_sums(const Pack<T> (&v)[N], T* sums) {
+#if defined(__AVX__)
+  if constexpr (std::is_same_v<T, float> && kLanes<T> == 8) {
+    for (int k = 0; k < N; k += 8) {
+      __m256 p[8];
+      for (int j = 0; j < 8; ++j) p[j] = k + j < N ? (__m256)v[k + j] : _mm256_setzero_ps();
+      // Pairs, then quads of lanes summed per pack: ab holds the four-lane sums of packs 0..3 in
+      // its low half (lanes 0..3) and of the same packs' lanes 4..7 in its high half.
+      const __m256 ab = _mm256_hadd_ps(_mm256_hadd_ps(p[0], p[1]), _mm256_hadd_ps(p[2], p[3]));
+      const __m256 cd = _mm256_hadd_ps(_mm256_hadd_ps(p[4], p[5]), _mm256_hadd_ps(p[6], p[7]));
+      const __m256 total =
+          _mm256_add_ps(_mm256_permute2f128_ps(ab, cd, 0x20), _mm256_permute2f128_ps(ab, cd, 0x31));
+      float out[8];
+      _mm256_storeu_ps(out, total);
+      std::memcpy(sums + k, out, sizeof(float) * std::min(8, N - k));
+    }
+    return;
+  }
+#endif
+  for (int k = 0; k < N; ++k) sums[k] = horizontal_sum<T>(v[k]);
 }
 
 // Number of set lanes of a comparison mask.
