@@ -23,6 +23,18 @@ T pixel_l1(const T* x, const T* y, const ImageShape& shape, size_t p) {
   return sum / shape.channels;
 }
 
+// n values of T that stay allocated for the thread's next call with the same Slot: SSIM's partials
+// are megabytes per image, which a fresh zeroed vector would page in and clear at every step.
+template <typename T, typename Slot>
+T* reused_buffer(size_t n) {
+  thread_local std::vector<T> buffer;
+  if (buffer.size() < n) buffer.resize(n);
+  return buffer.data();
+}
+
+struct SsimMapSlot;
+struct SsimPartialsSlot;
+
 template <typename T>
 std::vector<T> scaled(const T* weight, size_t count, double factor) {
   std::vector<T> out(count);
@@ -54,9 +66,14 @@ void l1_backward(const T* x, const T* y, const ImageShape& shape, const T* weigh
   check_shape(shape, "l1_backward");
   const int64_t pixels = int64_t(shape.pixels());
   const T inv_channels = T(1) / shape.channels;
-#pragma omp parallel for
-  for (int64_t i = 0; i < int64_t(shape.values()); ++i)
-    grad_x[i] += weight[i % pixels] * inv_channels * sign(x[i] - y[i]);
+  // Plane by plane, so that the pixel index needs no division and the loop vectorizes.
+#pragma omp parallel
+  for (int c = 0; c < shape.channels; ++c) {
+    const int64_t plane = c * pixels;
+#pragma omp for
+    for (int64_t p = 0; p < pixels; ++p)
+      grad_x[plane + p] += weight[p] * inv_channels * sign(x[plane + p] - y[plane + p]);
+  }
 }
 
 template <typename T>
@@ -80,16 +97,17 @@ double weighted_photometric_loss(const T* x, const T* y, const ImageShape& shape
   const size_t pixels = shape.pixels();
   const SsimSupport support = ssim_support(weight, shape);
   const bool sparse = support.sparse();
-  std::vector<T> ssim_map(pixels);
-  std::vector<T> partials(grad_x ? ssim_partials_size(shape) : 0);
-  T* partials_out = grad_x ? partials.data() : nullptr;
+  // A sparse weight leaves both unwritten outside its tiles, where the weight is zero.
+  T* ssim_map = reused_buffer<T, SsimMapSlot>(pixels);
+  T* partials = grad_x ? reused_buffer<T, SsimPartialsSlot>(ssim_partials_size(shape)) : nullptr;
   if (sparse)
-    ssim_in<T>(x, y, shape, support.weighted, ssim_map.data(), partials_out);
+    ssim_in<T>(x, y, shape, support.weighted, ssim_map, partials);
   else
-    ssim<T>(x, y, shape, ssim_map.data(), partials_out);
+    ssim<T>(x, y, shape, ssim_map, partials);
   double sum = 0;
 #pragma omp parallel for reduction(+ : sum)
   for (int64_t p = 0; p < int64_t(pixels); ++p) {
+    if (weight[p] == T(0)) continue;
     const double l1 = pixel_l1(x, y, shape, p);
     sum += double(weight[p]) * ((1 - lambda) * l1 + lambda * (1 - double(ssim_map[p])));
   }
@@ -97,9 +115,9 @@ double weighted_photometric_loss(const T* x, const T* y, const ImageShape& shape
     l1_backward(x, y, shape, scaled(weight, pixels, 1 - lambda).data(), grad_x);
     const std::vector<T> ssim_weight = scaled(weight, pixels, -lambda);
     if (sparse)
-      ssim_backward_in(x, y, shape, support.reached, partials.data(), ssim_weight.data(), grad_x);
+      ssim_backward_in(x, y, shape, support.reached, partials, ssim_weight.data(), grad_x);
     else
-      ssim_backward(x, y, shape, partials.data(), ssim_weight.data(), grad_x);
+      ssim_backward(x, y, shape, partials, ssim_weight.data(), grad_x);
   }
   return sum;
 }

@@ -262,7 +262,9 @@ class BackwardBox {
       const T* partial =
           partials_ + plane * shape_.values() + row_offset(shape_, c, r) + span_.first;
       T* in_image = padded + span_.padded_offset;
-      for (int x = 0; x < span_.count; ++x) in_image[x] = weight[x] * inv_channels * partial[x];
+      // Partials are only written where some weight is, and may be garbage elsewhere.
+      for (int x = 0; x < span_.count; ++x)
+        in_image[x] = weight[x] != T(0) ? weight[x] * inv_channels * partial[x] : T(0);
       const T* rows[kSsimWindow];
       for (int k = 0; k < kSsimWindow; ++k) rows[k] = padded + k;
       rows_.blur(window<T>().tap, rows, width_, ring_.row(r, plane));

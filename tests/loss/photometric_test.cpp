@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <vector>
 
 #include "loss/loss_test_support.hpp"
@@ -112,6 +113,14 @@ TEST(Photometric, SparseWeightsGiveTheLossAndGradientOfTheWholeImage) {
   ssim<double>(x.data(), y.data(), shape, nullptr, partials.data());
   ssim_backward(x.data(), y.data(), shape, partials.data(), ssim_weight.data(),
                 expected_gradient.data());
+
+  // A dense call on NaN images first: the sparse call, which writes its buffers only around the
+  // weighted pixels, must not read what is left of it elsewhere.
+  const std::vector<double> nan(shape.values(), std::numeric_limits<double>::quiet_NaN());
+  const std::vector<double> uniform(shape.pixels(), 1.0);
+  std::vector<double> ignored(shape.values(), 0.0);
+  weighted_photometric_loss(nan.data(), nan.data(), shape, kDssimWeight, uniform.data(),
+                            ignored.data());
 
   std::vector<double> gradient(shape.values(), 0.0);
   EXPECT_NEAR(weighted_photometric_loss(x.data(), y.data(), shape, kDssimWeight, weight.data(),
