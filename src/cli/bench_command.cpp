@@ -183,7 +183,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
         t.blend,
         t.blend_backward + t.project_backward,
         frame.bins.entry_count(),
-        size_t(std::count_if(radii.begin(), radii.begin() + n, [](int r) { return r > 0; }))};
+        size_t(std::count_if(radii.begin(), radii.end(), [](int r) { return r > 0; }))};
   };
   std::vector<RasterStageTimes> runs;
   const Timing total = time_runs(args.repeat.iterations, [&](int it) {

@@ -37,10 +37,10 @@ constexpr int kBlockColumns = kLanes<T> / kBlockRows<T>;
 // Where pixel (x, y) of the tile window lies in the block layout.
 template <typename T>
 int pixel_index(const TileWindow& win, int x, int y) {
-  constexpr int columns = kBlockColumns<T>;
+  constexpr int rows = kBlockRows<T>, columns = kBlockColumns<T>;
   const int dx = x - win.x0, dy = y - win.y0;
-  const int block = (dy / kBlockRows<T>)*(kTileSize / columns) + dx / columns;
-  return block * kLanes<T> + (dy % kBlockRows<T>)*columns + dx % columns;
+  const int block = (dy / rows) * (kTileSize / columns) + dx / columns;
+  return block * kLanes<T> + (dy % rows) * columns + dx % columns;
 }
 
 // Offsets of the lanes' pixel centers from a block's top left corner.
