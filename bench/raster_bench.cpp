@@ -17,7 +17,7 @@ struct BenchFrame {
   GaussianCloud cloud;
   std::vector<float> image, alpha, depth, pixel_grad;
   std::vector<int32_t> radii;
-  std::vector<float> dmeans, dscales, dquats, dlogits, dsh;
+  std::vector<float> dmeans, dscales, dquats, dlogits, dsh_dc, dsh_rest;
   RasterFrame<float> frame;
   const float background[3] = {1, 1, 1};
 
@@ -33,7 +33,8 @@ struct BenchFrame {
     dscales.resize(3 * n);
     dquats.resize(4 * n);
     dlogits.resize(n);
-    dsh.resize(3 * gs::kShCoefficients * n);
+    dsh_dc.resize(3 * n);
+    dsh_rest.resize(gs::kShRestFloats * n);
   }
   void forward() {
     rasterize_forward(cloud.params(), camera, background, frame,
@@ -44,7 +45,7 @@ struct BenchFrame {
     rasterize_backward(cloud.params(), frame,
                        PixelGrads<float>{pixel_grad.data(), pixel_grad.data(), pixel_grad.data()},
                        GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(),
-                                            dlogits.data(), dsh.data()});
+                                            dlogits.data(), dsh_dc.data(), dsh_rest.data()});
   }
 };
 

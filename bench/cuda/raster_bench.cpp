@@ -68,10 +68,10 @@ double ms_since(Clock::time_point start) {
 }
 
 // Gradient floats per Gaussian: GaussianGrads' arrays laid end to end.
-constexpr size_t kGradFloats = 3 + 3 + 4 + 1 + 3 * gs::kShCoefficients + 2 + 2;
+constexpr size_t kGradFloats = 3 + 3 + 4 + 1 + 3 + gs::kShRestFloats + 2 + 2;
 
 GaussianGrads<float> packed_grads(float* p, size_t n) {
-  return {p, p + 3 * n, p + 6 * n, p + 10 * n, p + 11 * n, p + 59 * n, p + 61 * n};
+  return {p, p + 3 * n, p + 6 * n, p + 10 * n, p + 11 * n, p + 14 * n, p + 59 * n, p + 61 * n};
 }
 
 // Every buffer of one frame, forward and backward, on the device.

@@ -162,8 +162,8 @@ void run_raster_bench(const RasterBenchArgs& args) {
   std::vector<int32_t> radii(n);
   // A loss gradient that reaches every output.
   const std::vector<float> dimage(3 * plane, 1e-3f), dalpha(plane, 1e-3f), ddepth(plane, 1e-4f);
-  std::vector<float> dmeans(3 * n), dscales(3 * n), dquats(4 * n), dlogits(n),
-      dsh(3 * gs::kShCoefficients * n), dview(2 * n), dview_abs(2 * n);
+  std::vector<float> dmeans(3 * n), dscales(3 * n), dquats(4 * n), dlogits(n), dsh_dc(3 * n),
+      dsh_rest(gs::kShRestFloats * n), dview(2 * n), dview_abs(2 * n);
   const float background[3] = {1, 1, 1};
   RasterFrame<float> frame;
   const auto render_frame = [&](const RasterCamera<float>& cam) {
@@ -174,7 +174,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
     rasterize_backward(
         g, frame, PixelGrads<float>{dimage.data(), dalpha.data(), ddepth.data()},
         GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(), dlogits.data(),
-                             dsh.data(), dview.data(), dview_abs.data()});
+                             dsh_dc.data(), dsh_rest.data(), dview.data(), dview_abs.data()});
     const RasterTimings& t = frame.timings;
     return RasterStageTimes{
         forward_ms,

@@ -84,7 +84,7 @@ const torch::Tensor& GaussianModel::param(Param p) const {
 }
 
 raster::GaussianTensors GaussianModel::render_tensors() const {
-  return {means,     log_scales,       quats,      opacity_logits, torch::cat({sh_dc, sh_rest}, 1),
+  return {means,     log_scales,       quats,      opacity_logits, sh_dc, sh_rest,
           filter_3d, active_sh_degree, antialiased};
 }
 

@@ -34,7 +34,7 @@ struct GaussianModel {
   torch::Tensor& param(Param p);
   const torch::Tensor& param(Param p) const;
 
-  // The tensors the rasterizer takes; the SH cat keeps the autograd path to both SH leaves.
+  // The tensors the rasterizer takes: the parameters themselves, so gradients reach them.
   raster::GaussianTensors render_tensors() const;
 
   // A copy that shares no storage with this model. Copying the struct shares the tensors, and

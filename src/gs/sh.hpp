@@ -1,13 +1,24 @@
 #pragma once
 // View-dependent color from real spherical harmonics up to degree 3, as 3DGS evaluates it:
 // color = max(0, sum_k basis_k(dir) * sh_k + 0.5), dir the unit vector from the camera center to
-// the Gaussian's mean. Coefficients are stored (16, 3) per Gaussian whatever the active degree.
+// the Gaussian's mean. Coefficients are stored (16, 3) per Gaussian whatever the active degree,
+// band 0 apart from the others as 3DGS models keep them (sh_dc (N, 1, 3), sh_rest (N, 15, 3)).
 #include "raster/geometry.hpp"
 
 namespace iesrgs::gs {
 
 constexpr int kShCoefficients = 16;  // degree 3
 constexpr int kMaxShDegree = 3;
+constexpr int kShRestFloats = 3 * (kShCoefficients - 1);  // bands 1..3 of one Gaussian
+
+// One Gaussian's coefficients, or their gradients (T non-const): coefficient k of channel c.
+template <typename T>
+struct ShBands {
+  T* dc;    // (3)
+  T* rest;  // (15, 3)
+
+  IESRGS_HD T& operator()(int k, int c) const { return k == 0 ? dc[c] : rest[3 * (k - 1) + c]; }
+};
 
 IESRGS_HD int sh_count(int degree) {
   return (degree + 1) * (degree + 1);
@@ -67,16 +78,17 @@ IESRGS_HD void sh_basis(int degree, T x, T y, T z, T* b, raster::Vec3T<T>* grad)
   }
 }
 
-// Color seen along `view` (camera center to mean, any length); sh is the Gaussian's (16, 3) block.
+// Color seen along `view` (camera center to mean, any length).
 template <typename T>
-IESRGS_HD void sh_to_color(int degree, const T* sh, const raster::Vec3T<T>& view, T* color) {
+IESRGS_HD void sh_to_color(int degree, ShBands<const T> sh, const raster::Vec3T<T>& view,
+                           T* color) {
   const T inv = T(1) / hd::sqrt(raster::dot(view, view));
   T b[kShCoefficients];
   sh_basis(degree, view.x * inv, view.y * inv, view.z * inv, b,
            static_cast<raster::Vec3T<T>*>(nullptr));
   for (int c = 0; c < 3; ++c) {
     T sum = T(0.5);
-    for (int k = 0; k < sh_count(degree); ++k) sum += b[k] * sh[3 * k + c];
+    for (int k = 0; k < sh_count(degree); ++k) sum += b[k] * sh(k, c);
     color[c] = hd::max(sum, T(0));
   }
 }
@@ -84,8 +96,8 @@ IESRGS_HD void sh_to_color(int degree, const T* sh, const raster::Vec3T<T>& view
 // Gradients of the coefficients (written to dsh, all 16 rows; rows beyond the degree get zero)
 // and of `view` (added to dview) from dcolor. Channels clamped at zero pass no gradient.
 template <typename T>
-IESRGS_HD void sh_to_color_backward(int degree, const T* sh, const raster::Vec3T<T>& view,
-                                    const T* dcolor, T* dsh, raster::Vec3T<T>& dview) {
+IESRGS_HD void sh_to_color_backward(int degree, ShBands<const T> sh, const raster::Vec3T<T>& view,
+                                    const T* dcolor, ShBands<T> dsh, raster::Vec3T<T>& dview) {
   const T inv = T(1) / hd::sqrt(raster::dot(view, view));
   const raster::Vec3T<T> dir = inv * view;
   T b[kShCoefficients];
@@ -95,14 +107,14 @@ IESRGS_HD void sh_to_color_backward(int degree, const T* sh, const raster::Vec3T
   T live[3];
   for (int c = 0; c < 3; ++c) {
     T sum = T(0.5);
-    for (int k = 0; k < count; ++k) sum += b[k] * sh[3 * k + c];
+    for (int k = 0; k < count; ++k) sum += b[k] * sh(k, c);
     live[c] = hd::select(sum < T(0), T(0), dcolor[c]);
   }
   raster::Vec3T<T> ddir{0, 0, 0};
   for (int k = 0; k < kShCoefficients; ++k)
     for (int c = 0; c < 3; ++c) {
-      dsh[3 * k + c] = k < count ? b[k] * live[c] : T(0);
-      if (k < count) ddir = ddir + (live[c] * sh[3 * k + c]) * db[k];
+      dsh(k, c) = k < count ? b[k] * live[c] : T(0);
+      if (k < count) ddir = ddir + (live[c] * sh(k, c)) * db[k];
     }
   // Through the normalization of the view direction.
   dview = dview + inv * (ddir - raster::dot(ddir, dir) * dir);

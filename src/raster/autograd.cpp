@@ -92,7 +92,8 @@ void check_inputs(const GaussianTensors& g, const ViewspaceProbes& probes) {
   check_tensor(g.log_scales, "log_scales", {n, 3}, device);
   check_tensor(g.quats, "quats", {n, 4}, device);
   check_tensor(g.opacity_logits, "opacity_logits", {n}, device);
-  check_tensor(g.sh, "sh", {n, gs::kShCoefficients, 3}, device);
+  check_tensor(g.sh_dc, "sh_dc", {n, 1, 3}, device);
+  check_tensor(g.sh_rest, "sh_rest", {n, gs::kShCoefficients - 1, 3}, device);
   if (g.filter_std.defined()) check_tensor(g.filter_std, "filter_std", {n}, device);
   if (probes.grad.defined()) check_tensor(probes.grad, "viewspace probe", {n, 2}, device);
   if (probes.abs_grad.defined())
@@ -100,8 +101,8 @@ void check_inputs(const GaussianTensors& g, const ViewspaceProbes& probes) {
 }
 
 GaussianParams<float> params_of(const Tensor& means, const Tensor& log_scales, const Tensor& quats,
-                                const Tensor& logits, const Tensor& sh, const Tensor& filter_std,
-                                int sh_degree, bool antialiased) {
+                                const Tensor& logits, const Tensor& sh_dc, const Tensor& sh_rest,
+                                const Tensor& filter_std, int sh_degree, bool antialiased) {
   GaussianParams<float> g;
   g.count = int(means.size(0));
   g.sh_degree = sh_degree;
@@ -110,7 +111,8 @@ GaussianParams<float> params_of(const Tensor& means, const Tensor& log_scales, c
   g.log_scales = log_scales.data_ptr<float>();
   g.quats = quats.data_ptr<float>();
   g.opacity_logits = logits.data_ptr<float>();
-  g.sh = sh.data_ptr<float>();
+  g.sh_dc = sh_dc.data_ptr<float>();
+  g.sh_rest = sh_rest.data_ptr<float>();
   g.filter_std = filter_std.defined() ? filter_std.data_ptr<float>() : nullptr;
   return g;
 }
@@ -124,18 +126,19 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
   // Probes are inputs only so that autograd routes the screen-space gradients to them. Optional
   // inputs arrive as empty placeholders (autograd cannot take undefined tensors) with a flag.
   static variable_list forward(AutogradContext* ctx, Tensor means, Tensor log_scales, Tensor quats,
-                               Tensor logits, Tensor sh, Tensor filter_std, Tensor /*probe*/,
-                               Tensor /*abs_probe*/, RasterCamera<float> camera,
+                               Tensor logits, Tensor sh_dc, Tensor sh_rest, Tensor filter_std,
+                               Tensor /*probe*/, Tensor /*abs_probe*/, RasterCamera<float> camera,
                                std::array<float, 3> background, int64_t sh_degree, bool antialiased,
                                std::array<bool, 3> present) {
     means = means.contiguous();
     log_scales = log_scales.contiguous();
     quats = quats.contiguous();
     logits = logits.contiguous();
-    sh = sh.contiguous();
+    sh_dc = sh_dc.contiguous();
+    sh_rest = sh_rest.contiguous();
     filter_std = present[0] ? filter_std.contiguous() : Tensor();
-    const GaussianParams<float> g =
-        params_of(means, log_scales, quats, logits, sh, filter_std, int(sh_degree), antialiased);
+    const GaussianParams<float> g = params_of(means, log_scales, quats, logits, sh_dc, sh_rest,
+                                              filter_std, int(sh_degree), antialiased);
     auto holder = c10::make_intrusive<FrameHolder>();
     const auto f32 = means.options();
     Tensor image = torch::empty({3, camera.height, camera.width}, f32);
@@ -154,7 +157,7 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
       holder->frame = pool<RasterFrame<float>>().take();
       rasterize_forward(g, camera, background.data(), *holder->frame, targets);
     }
-    ctx->save_for_backward({means, log_scales, quats, logits, sh, filter_std});
+    ctx->save_for_backward({means, log_scales, quats, logits, sh_dc, sh_rest, filter_std});
     ctx->saved_data["frame"] = c10::IValue::make_capsule(holder);
     ctx->saved_data["sh_degree"] = sh_degree;
     ctx->saved_data["antialiased"] = antialiased;
@@ -167,14 +170,14 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
   static variable_list backward(AutogradContext* ctx, variable_list grad_outputs) {
     const variable_list saved = ctx->get_saved_variables();
     const Tensor& means = saved[0];
-    const GaussianParams<float> g = params_of(means, saved[1], saved[2], saved[3], saved[4],
-                                              saved[5], int(ctx->saved_data["sh_degree"].toInt()),
-                                              ctx->saved_data["antialiased"].toBool());
+    const GaussianParams<float> g = params_of(
+        means, saved[1], saved[2], saved[3], saved[4], saved[5], saved[6],
+        int(ctx->saved_data["sh_degree"].toInt()), ctx->saved_data["antialiased"].toBool());
     auto holder =
         c10::static_intrusive_pointer_cast<FrameHolder>(ctx->saved_data["frame"].toCapsule());
     Tensor dmeans = torch::empty_like(means), dlog_scales = torch::empty_like(saved[1]);
     Tensor dquats = torch::empty_like(saved[2]), dlogits = torch::empty_like(saved[3]);
-    Tensor dsh = torch::empty_like(saved[4]);
+    Tensor dsh_dc = torch::empty_like(saved[4]), dsh_rest = torch::empty_like(saved[5]);
     Tensor dprobe =
         ctx->saved_data["probe"].toBool() ? torch::empty({g.count, 2}, means.options()) : Tensor();
     Tensor dabs_probe = ctx->saved_data["abs_probe"].toBool()
@@ -187,16 +190,16 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
                                         data_or_null(pixel[2])};
     const GaussianGrads<float> grads{dmeans.data_ptr<float>(), dlog_scales.data_ptr<float>(),
                                      dquats.data_ptr<float>(), dlogits.data_ptr<float>(),
-                                     dsh.data_ptr<float>(),    data_or_null(dprobe),
-                                     data_or_null(dabs_probe)};
+                                     dsh_dc.data_ptr<float>(), dsh_rest.data_ptr<float>(),
+                                     data_or_null(dprobe),     data_or_null(dabs_probe)};
 #ifdef IESRGS_WITH_CUDA
     if (holder->device)
       holder->device->backward(g, pixel_grads, grads);
     else
 #endif
       rasterize_backward(g, *holder->frame, pixel_grads, grads);
-    return {dmeans,     dlog_scales, dquats,   dlogits,  dsh,      Tensor(), dprobe,
-            dabs_probe, Tensor(),    Tensor(), Tensor(), Tensor(), Tensor()};
+    return {dmeans, dlog_scales, dquats,   dlogits,  dsh_dc,   dsh_rest, Tensor(),
+            dprobe, dabs_probe,  Tensor(), Tensor(), Tensor(), Tensor(), Tensor()};
   }
 };
 
@@ -210,9 +213,9 @@ RenderOutput render(const GaussianTensors& gaussians, const RasterCamera<float>&
   };
   const variable_list out = RasterizeFunction::apply(
       gaussians.means, gaussians.log_scales, gaussians.quats, gaussians.opacity_logits,
-      gaussians.sh, or_placeholder(gaussians.filter_std), or_placeholder(probes.grad),
-      or_placeholder(probes.abs_grad), camera, background, int64_t(gaussians.sh_degree),
-      gaussians.antialiased,
+      gaussians.sh_dc, gaussians.sh_rest, or_placeholder(gaussians.filter_std),
+      or_placeholder(probes.grad), or_placeholder(probes.abs_grad), camera, background,
+      int64_t(gaussians.sh_degree), gaussians.antialiased,
       std::array<bool, 3>{gaussians.filter_std.defined(), probes.grad.defined(),
                           probes.abs_grad.defined()});
   return {out[0], out[1], out[2], out[3]};
@@ -220,11 +223,13 @@ RenderOutput render(const GaussianTensors& gaussians, const RasterCamera<float>&
 
 GaussianParams<float> kernel_params(const GaussianTensors& gaussians) {
   check_inputs(gaussians, {});
-  for (const Tensor* t : {&gaussians.means, &gaussians.log_scales, &gaussians.quats,
-                          &gaussians.opacity_logits, &gaussians.sh, &gaussians.filter_std})
+  for (const Tensor* t :
+       {&gaussians.means, &gaussians.log_scales, &gaussians.quats, &gaussians.opacity_logits,
+        &gaussians.sh_dc, &gaussians.sh_rest, &gaussians.filter_std})
     if (t->defined() && !t->is_contiguous()) fail("kernel_params: a tensor is not contiguous");
   return params_of(gaussians.means, gaussians.log_scales, gaussians.quats, gaussians.opacity_logits,
-                   gaussians.sh, gaussians.filter_std, gaussians.sh_degree, gaussians.antialiased);
+                   gaussians.sh_dc, gaussians.sh_rest, gaussians.filter_std, gaussians.sh_degree,
+                   gaussians.antialiased);
 }
 
 }  // namespace iesrgs::raster

@@ -15,7 +15,8 @@ struct GaussianTensors {
   torch::Tensor log_scales;      // (N, 3)
   torch::Tensor quats;           // (N, 4) w x y z
   torch::Tensor opacity_logits;  // (N)
-  torch::Tensor sh;              // (N, 16, 3)
+  torch::Tensor sh_dc;           // (N, 1, 3) SH band 0
+  torch::Tensor sh_rest;         // (N, 15, 3) SH bands 1..3
   torch::Tensor filter_std;      // (N) Mip-Splatting 3D filter, no gradient; undefined = none
   int sh_degree = 0;
   bool antialiased = true;  // Mip-Splatting's 2D filter; false: 3DGS's dilation

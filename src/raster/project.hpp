@@ -49,7 +49,7 @@ struct GaussianRow {
   const T* quat;       // (4)
   T opacity_logit;
   T filter_std;  // 0 without the 3D filter
-  const T* sh;   // (16, 3)
+  gs::ShBands<const T> sh;
   int sh_degree;
   bool antialiased;
 };
@@ -61,7 +61,7 @@ IESRGS_HD GaussianRow<T> gaussian_row(const GaussianParams<T>& g, int i) {
           g.quats + 4 * i,
           g.opacity_logits[i],
           g.filter_std ? g.filter_std[i] : T(0),
-          g.sh + 3 * gs::kShCoefficients * i,
+          {g.sh_dc + 3 * i, g.sh_rest + gs::kShRestFloats * i},
           g.sh_degree,
           g.antialiased};
 }
@@ -73,7 +73,8 @@ struct GaussianRowGrad {
   T log_scale[3];
   T quat[4];
   T opacity_logit;
-  T sh[3 * gs::kShCoefficients];
+  T sh_dc[3];
+  T sh_rest[gs::kShRestFloats];
   T viewspace[2], viewspace_abs[2];
 };
 
@@ -323,8 +324,8 @@ IESRGS_HD hd::Mask<T> project_backward(const GaussianRow<T>& g, const RasterCame
 
   // Color through the spherical harmonics and the view direction.
   out.mean = mul_transposed(w, dview);
-  gs::sh_to_color_backward(g.sh_degree, g.sh, g.mean - camera_center(cam), ds.color, out.sh,
-                           out.mean);
+  gs::sh_to_color_backward(g.sh_degree, g.sh, g.mean - camera_center(cam), ds.color,
+                           gs::ShBands<T>{out.sh_dc, out.sh_rest}, out.mean);
   return visible;
 }
 
@@ -342,8 +343,9 @@ IESRGS_HD void add_row_grad(const GaussianRowGrad<T>& d, int i, const GaussianGr
   grads.opacity_logits[i] += d.opacity_logit;
   for (int k = 0; k < 3; ++k) grads.log_scales[3 * i + k] += d.log_scale[k];
   for (int k = 0; k < 4; ++k) grads.quats[4 * i + k] += d.quat[k];
-  for (int k = 0; k < 3 * gs::kShCoefficients; ++k)
-    grads.sh[3 * gs::kShCoefficients * i + k] += d.sh[k];
+  for (int k = 0; k < 3; ++k) grads.sh_dc[3 * i + k] += d.sh_dc[k];
+  for (int k = 0; k < gs::kShRestFloats; ++k)
+    grads.sh_rest[gs::kShRestFloats * i + k] += d.sh_rest[k];
   grads.means[3 * i] += d.mean.x;
   grads.means[3 * i + 1] += d.mean.y;
   grads.means[3 * i + 2] += d.mean.z;

@@ -51,7 +51,8 @@ void validate_inputs(const GaussianParams<T>& g, const RasterCamera<T>& cam) {
   if (g.count < 0) fail("rasterizer: negative Gaussian count {}", g.count);
   if (g.sh_degree < 0 || g.sh_degree > gs::kMaxShDegree)
     fail("rasterizer: SH degree {} is outside 0..{}", g.sh_degree, gs::kMaxShDegree);
-  if (g.count > 0 && !(g.means && g.log_scales && g.quats && g.opacity_logits && g.sh))
+  if (g.count > 0 &&
+      !(g.means && g.log_scales && g.quats && g.opacity_logits && g.sh_dc && g.sh_rest))
     fail("rasterizer: a Gaussian parameter array is missing");
 }
 

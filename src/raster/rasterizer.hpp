@@ -37,12 +37,13 @@ struct GradArray {
 
 // Every array of grads for n Gaussians, for the backward passes to clear.
 template <typename T>
-std::array<GradArray<T>, 7> grad_arrays(const GaussianGrads<T>& grads, size_t n) {
+std::array<GradArray<T>, 8> grad_arrays(const GaussianGrads<T>& grads, size_t n) {
   return {{{grads.means, 3 * n},
            {grads.log_scales, 3 * n},
            {grads.quats, 4 * n},
            {grads.opacity_logits, n},
-           {grads.sh, 3 * gs::kShCoefficients * n},
+           {grads.sh_dc, 3 * n},
+           {grads.sh_rest, gs::kShRestFloats * n},
            {grads.viewspace, 2 * n},
            {grads.viewspace_abs, 2 * n}}};
 }

@@ -27,7 +27,8 @@ GaussianCloud synthetic_scene(int count, const RasterCamera<float>& cam, uint32_
   c.log_scales.reserve(3 * n);
   c.quats.reserve(4 * n);
   c.opacity_logits.reserve(n);
-  c.sh.reserve(3 * gs::kShCoefficients * n);
+  c.sh_dc.reserve(3 * n);
+  c.sh_rest.reserve(gs::kShRestFloats * n);
   c.filter_std.reserve(n);
   // Median screen std 1.2 px at the middle depth.
   const float median_scale = 1.2f * 4.0f / cam.fx;
@@ -42,7 +43,8 @@ GaussianCloud synthetic_scene(int count, const RasterCamera<float>& cam, uint32_
     for (int k = 0; k < 4; ++k) c.quats.push_back(normal(rng));
     c.opacity_logits.push_back(2.5f * normal(rng));
     for (int k = 0; k < gs::kShCoefficients; ++k)
-      for (int ch = 0; ch < 3; ++ch) c.sh.push_back((k == 0 ? 0.8f : 0.05f) * normal(rng));
+      for (int ch = 0; ch < 3; ++ch)
+        (k == 0 ? c.sh_dc : c.sh_rest).push_back((k == 0 ? 0.8f : 0.05f) * normal(rng));
     // Mip-Splatting's filter for this one camera: z / f * sqrt(0.2).
     c.filter_std.push_back(z / cam.fx * std::sqrt(0.2f));
   }

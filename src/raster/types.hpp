@@ -28,7 +28,8 @@ struct GaussianParams {
   const T* log_scales = nullptr;      // (N, 3)
   const T* quats = nullptr;           // (N, 4) w x y z, unnormalized
   const T* opacity_logits = nullptr;  // (N)
-  const T* sh = nullptr;              // (N, 16, 3)
+  const T* sh_dc = nullptr;           // (N, 1, 3) SH band 0
+  const T* sh_rest = nullptr;         // (N, 15, 3) SH bands 1..3
   const T* filter_std = nullptr;      // (N) Mip-Splatting 3D filter; nullptr means none
   bool antialiased = true;  // Mip-Splatting's 2D filter; false: 3DGS's dilation ("classic")
 };
@@ -44,7 +45,8 @@ GaussianParams<T> params_of(const Storage& storage) {
   g.log_scales = storage.log_scales.data();
   g.quats = storage.quats.data();
   g.opacity_logits = storage.opacity_logits.data();
-  g.sh = storage.sh.data();
+  g.sh_dc = storage.sh_dc.data();
+  g.sh_rest = storage.sh_rest.data();
   g.filter_std = storage.filter_std.size() > 0 ? storage.filter_std.data() : nullptr;
   g.antialiased = storage.antialiased;
   return g;
@@ -54,7 +56,7 @@ GaussianParams<T> params_of(const Storage& storage) {
 template <typename T>
 struct GaussianBuffers {
   int sh_degree = 3;
-  std::vector<T> means, log_scales, quats, opacity_logits, sh, filter_std;
+  std::vector<T> means, log_scales, quats, opacity_logits, sh_dc, sh_rest, filter_std;
   bool antialiased = true;
 
   int count() const { return int(opacity_logits.size()); }
@@ -69,7 +71,8 @@ struct GaussianGrads {
   T* log_scales = nullptr;
   T* quats = nullptr;
   T* opacity_logits = nullptr;
-  T* sh = nullptr;
+  T* sh_dc = nullptr;
+  T* sh_rest = nullptr;
   // (N, 2) gradient of the projected mean in NDC units ([-1, 1] across the image), as 3DGS
   // reports it, so its 2e-4 densification threshold applies; and the sum over pixels of the
   // absolute per-pixel contributions (Mip-Splatting / GOF), same units.

@@ -30,7 +30,8 @@ void expect_gradients_match_the_raw_backward(bool antialiased) {
                     tensor_of(s.log_scales, {n, 3}),
                     tensor_of(s.quats, {n, 4}),
                     tensor_of(s.opacity_logits, {n}),
-                    tensor_of(s.sh, {n, 16, 3}),
+                    tensor_of(s.sh_dc, {n, 1, 3}),
+                    tensor_of(s.sh_rest, {n, 15, 3}),
                     torch::tensor(s.filter_std),
                     s.sh_degree,
                     antialiased};
@@ -47,18 +48,19 @@ void expect_gradients_match_the_raw_backward(bool antialiased) {
   KernelRender<float> raw = kernel_render(s, cam, bg);
   EXPECT_EQ(values(out.image), raw.image);
   EXPECT_EQ(values(out.depth), raw.depth);
-  std::vector<float> dmeans(3 * n), dscales(3 * n), dquats(4 * n), dlogits(n), dsh(48 * n),
-      dview(2 * n), dview_abs(2 * n);
+  std::vector<float> dmeans(3 * n), dscales(3 * n), dquats(4 * n), dlogits(n), dsh_dc(3 * n),
+      dsh_rest(45 * n), dview(2 * n), dview_abs(2 * n);
   const std::vector<float> vwi = values(wi), vwa = values(wa), vwd = values(wd);
   rasterize_backward(
       s.params(), raw.frame, PixelGrads<float>{vwi.data(), vwa.data(), vwd.data()},
-      GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(), dlogits.data(), dsh.data(),
-                           dview.data(), dview_abs.data()});
+      GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(), dlogits.data(),
+                           dsh_dc.data(), dsh_rest.data(), dview.data(), dview_abs.data()});
   EXPECT_EQ(values(g.means.grad()), dmeans);
   EXPECT_EQ(values(g.log_scales.grad()), dscales);
   EXPECT_EQ(values(g.quats.grad()), dquats);
   EXPECT_EQ(values(g.opacity_logits.grad()), dlogits);
-  EXPECT_EQ(values(g.sh.grad()), dsh);
+  EXPECT_EQ(values(g.sh_dc.grad()), dsh_dc);
+  EXPECT_EQ(values(g.sh_rest.grad()), dsh_rest);
   EXPECT_EQ(values(probes.grad.grad()), dview);
   EXPECT_EQ(values(probes.abs_grad.grad()), dview_abs);
   EXPECT_GT(torch::abs(g.means.grad()).sum().item<float>(), 0.f);
@@ -80,7 +82,8 @@ TEST(RasterAutograd, FilterAndProbesAreOptional) {
                     tensor_of(s.log_scales, {n, 3}),
                     tensor_of(s.quats, {n, 4}),
                     tensor_of(s.opacity_logits, {n}),
-                    tensor_of(s.sh, {n, 16, 3}),
+                    tensor_of(s.sh_dc, {n, 1, 3}),
+                    tensor_of(s.sh_rest, {n, 15, 3}),
                     torch::Tensor(),
                     s.sh_degree};
   const RenderOutput plain = render(g, raster_camera<float>(cam), {1, 1, 1});
@@ -104,16 +107,13 @@ TEST(RasterAutograd, CudaMatchesCpu) {
   const Camera cam = posed_test_camera(120, 96);
   const Scene<float> s = random_scene(cam, 3000, 3, 29).cast<float>();
   const int64_t n = s.count();
-  const GaussianTensors cpu{tensor_of(s.means, {n, 3}),
-                            tensor_of(s.log_scales, {n, 3}),
-                            tensor_of(s.quats, {n, 4}),
-                            tensor_of(s.opacity_logits, {n}),
-                            tensor_of(s.sh, {n, 16, 3}),
-                            torch::tensor(s.filter_std),
-                            s.sh_degree};
+  const GaussianTensors cpu{tensor_of(s.means, {n, 3}),    tensor_of(s.log_scales, {n, 3}),
+                            tensor_of(s.quats, {n, 4}),    tensor_of(s.opacity_logits, {n}),
+                            tensor_of(s.sh_dc, {n, 1, 3}), tensor_of(s.sh_rest, {n, 15, 3}),
+                            torch::tensor(s.filter_std),   s.sh_degree};
   GaussianTensors gpu = cpu;
-  for (torch::Tensor* t :
-       {&gpu.means, &gpu.log_scales, &gpu.quats, &gpu.opacity_logits, &gpu.sh, &gpu.filter_std})
+  for (torch::Tensor* t : {&gpu.means, &gpu.log_scales, &gpu.quats, &gpu.opacity_logits, &gpu.sh_dc,
+                           &gpu.sh_rest, &gpu.filter_std})
     *t = testing::on_cuda(*t);
   const auto probes_on = [&](torch::Device device) {
     const auto options = torch::TensorOptions().device(device).requires_grad(true);
@@ -146,7 +146,8 @@ TEST(RasterAutograd, CudaMatchesCpu) {
       {"log_scales", {gpu.log_scales.grad(), cpu.log_scales.grad()}},
       {"quats", {gpu.quats.grad(), cpu.quats.grad()}},
       {"opacity_logits", {gpu.opacity_logits.grad(), cpu.opacity_logits.grad()}},
-      {"sh", {gpu.sh.grad(), cpu.sh.grad()}},
+      {"sh_dc", {gpu.sh_dc.grad(), cpu.sh_dc.grad()}},
+      {"sh_rest", {gpu.sh_rest.grad(), cpu.sh_rest.grad()}},
       {"viewspace", {gpu_probes.grad.grad(), cpu_probes.grad.grad()}},
       {"viewspace_abs", {gpu_probes.abs_grad.grad(), cpu_probes.abs_grad.grad()}}};
   for (const auto& [name, pair] : grads)
@@ -155,18 +156,15 @@ TEST(RasterAutograd, CudaMatchesCpu) {
 
 TEST(RasterAutograd, RejectsWrongShapes) {
   const Camera cam = test_camera(16, 16);
-  GaussianTensors g{torch::zeros({4, 3}),
-                    torch::zeros({4, 3}),
-                    torch::zeros({4, 4}),
-                    torch::zeros({4}),
-                    torch::zeros({4, 9, 3}),
-                    torch::Tensor(),
-                    0};
+  GaussianTensors g{
+      torch::zeros({4, 3}),    torch::zeros({4, 3}),    torch::zeros({4, 4}), torch::zeros({4}),
+      torch::zeros({4, 1, 3}), torch::zeros({4, 8, 3}), torch::Tensor(),      0};
   EXPECT_THROW(render(g, raster_camera<float>(cam), {0, 0, 0}), Error);
-  g.sh = torch::zeros({4, 16, 3}, torch::kFloat64);
+  g.sh_rest = torch::zeros({4, 15, 3}, torch::kFloat64);
   EXPECT_THROW(render(g, raster_camera<float>(cam), {0, 0, 0}), Error);
   // Tensors on a device this build has no rasterizer for.
-  for (torch::Tensor* t : {&g.means, &g.log_scales, &g.quats, &g.opacity_logits, &g.sh})
+  for (torch::Tensor* t :
+       {&g.means, &g.log_scales, &g.quats, &g.opacity_logits, &g.sh_dc, &g.sh_rest})
     *t = torch::zeros(t->sizes(), torch::Device(torch::kMeta));
   try {
     render(g, raster_camera<float>(cam), {0, 0, 0});

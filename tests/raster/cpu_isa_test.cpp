@@ -39,12 +39,13 @@ Differentiated<T> render_and_differentiate(Isa isa, const Scene<T>& s, const Cam
   const std::vector<T> dalpha = random_values<T>(d.render.alpha.size(), rng);
   const std::vector<T> ddepth = random_values<T>(d.render.depth.size(), rng);
   const size_t n = s.count();
-  for (size_t size : {3 * n, 3 * n, 4 * n, n, 48 * n, 2 * n, 2 * n}) d.grads.emplace_back(size);
+  for (size_t size : {3 * n, 3 * n, 4 * n, n, 3 * n, 45 * n, 2 * n, 2 * n})
+    d.grads.emplace_back(size);
   std::vector<T*> g;
   for (std::vector<T>& v : d.grads) g.push_back(v.data());
   rasterize_backward(s.params(), d.render.frame,
                      PixelGrads<T>{dimage.data(), dalpha.data(), ddepth.data()},
-                     GaussianGrads<T>{g[0], g[1], g[2], g[3], g[4], g[5], g[6]});
+                     GaussianGrads<T>{g[0], g[1], g[2], g[3], g[4], g[5], g[6], g[7]});
   return d;
 }
 

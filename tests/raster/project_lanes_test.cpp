@@ -44,17 +44,19 @@ Projected project_passes(Isa isa, const GaussianParams<float>& g, const RasterCa
   return out;
 }
 
-// Gradient arrays in GaussianGrads order: means, log-scales, quats, logits, SH, viewspace (+ abs).
+// Gradient arrays in GaussianGrads order: means, log-scales, quats, logits, SH (DC, rest),
+// viewspace (+ abs).
 using Grads = std::vector<std::vector<float>>;
 
 GaussianGrads<float> view(Grads& d) {
   return {d[0].data(), d[1].data(), d[2].data(), d[3].data(),
-          d[4].data(), d[5].data(), d[6].data()};
+          d[4].data(), d[5].data(), d[6].data(), d[7].data()};
 }
 
 Grads zero_grads(int n) {
   Grads d;
-  for (int size : {3 * n, 3 * n, 4 * n, n, 48 * n, 2 * n, 2 * n}) d.emplace_back(size_t(size));
+  for (int size : {3 * n, 3 * n, 4 * n, n, 3 * n, 45 * n, 2 * n, 2 * n})
+    d.emplace_back(size_t(size));
   return d;
 }
 

@@ -26,12 +26,14 @@ struct Scene : GaussianBuffers<T> {
     s.log_scales = conv(this->log_scales);
     s.quats = conv(this->quats);
     s.opacity_logits = conv(this->opacity_logits);
-    s.sh = conv(this->sh);
+    s.sh_dc = conv(this->sh_dc);
+    s.sh_rest = conv(this->sh_rest);
     s.filter_std = conv(this->filter_std);
     s.antialiased = this->antialiased;
     return s;
   }
-  // Appends one Gaussian; sh_dc sets the DC color term, higher bands from `rest`.
+  // Appends one Gaussian; `dc` sets SH band 0 (the base color), `rest` the higher bands (zero
+  // where it ends).
   void add(const Vec3& mean, const Vec3& log_scale, const std::array<double, 4>& quat, double logit,
            const std::array<double, 3>& dc, double filter, const std::vector<double>& rest = {}) {
     for (int k = 0; k < 3; ++k) {
@@ -40,11 +42,9 @@ struct Scene : GaussianBuffers<T> {
     }
     for (double q : quat) this->quats.push_back(T(q));
     this->opacity_logits.push_back(T(logit));
-    for (int k = 0; k < gs::kShCoefficients; ++k)
-      for (int c = 0; c < 3; ++c) {
-        const size_t r = size_t(3 * (k - 1) + c);
-        this->sh.push_back(T(k == 0 ? dc[c] : (r < rest.size() ? rest[r] : 0.0)));
-      }
+    for (double c : dc) this->sh_dc.push_back(T(c));
+    for (size_t r = 0; r < size_t(gs::kShRestFloats); ++r)
+      this->sh_rest.push_back(T(r < rest.size() ? rest[r] : 0.0));
     this->filter_std.push_back(T(filter));
   }
 };

@@ -158,11 +158,12 @@ std::vector<float> differentiate(const Scene<float>& s, KernelRender<float>& r, 
   const std::vector<float> dimage(r.image.size(), 1.f);
   const size_t n = s.count();
   std::vector<float> dmeans(3 * n, stale), dscales(3 * n, stale), dquats(4 * n, stale),
-      dlogits(n, stale), dsh(48 * n, stale);
+      dlogits(n, stale), dsh_dc(3 * n, stale), dsh_rest(45 * n, stale);
   rasterize_backward(s.params(), r.frame, PixelGrads<float>{dimage.data()},
                      GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(),
-                                          dlogits.data(), dsh.data()});
-  dmeans.insert(dmeans.end(), dsh.begin(), dsh.end());
+                                          dlogits.data(), dsh_dc.data(), dsh_rest.data()});
+  dmeans.insert(dmeans.end(), dsh_dc.begin(), dsh_dc.end());
+  dmeans.insert(dmeans.end(), dsh_rest.begin(), dsh_rest.end());
   return dmeans;
 }
 
@@ -260,7 +261,8 @@ TEST(RasterForward, DivergedGaussiansCoverNothing) {
                           {&mixed.log_scales, &bad.log_scales},
                           {&mixed.quats, &bad.quats},
                           {&mixed.opacity_logits, &bad.opacity_logits},
-                          {&mixed.sh, &bad.sh},
+                          {&mixed.sh_dc, &bad.sh_dc},
+                          {&mixed.sh_rest, &bad.sh_rest},
                           {&mixed.filter_std, &bad.filter_std}})
     to->insert(to->end(), from->begin(), from->end());
 

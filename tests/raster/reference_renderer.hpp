@@ -26,9 +26,9 @@ struct ReferenceSplat {
   double color[3];
 };
 
-inline double sh_channel(int degree, const double* sh, int c, const Vec3& d) {
+inline double sh_channel(int degree, const double* dc, const double* rest, int c, const Vec3& d) {
   const double x = d.x, y = d.y, z = d.z;
-  const auto k = [&](int i) { return sh[3 * i + c]; };
+  const auto k = [&](int i) { return i == 0 ? dc[c] : rest[3 * (i - 1) + c]; };
   double r = 0.28209479177387814 * k(0);
   if (degree > 0) r += 0.4886025119029199 * (-y * k(1) + z * k(2) - x * k(3));
   if (degree > 1)
@@ -87,7 +87,8 @@ inline bool reference_project(const Scene<double>& s, int i, const Camera& cam,
   out.conic[2] = a / det1;
   Vec3 dir = mean - cam.center();
   dir = dir * (1 / dir.norm());
-  for (int ch = 0; ch < 3; ++ch) out.color[ch] = sh_channel(s.sh_degree, &s.sh[48 * i], ch, dir);
+  for (int ch = 0; ch < 3; ++ch)
+    out.color[ch] = sh_channel(s.sh_degree, &s.sh_dc[3 * i], &s.sh_rest[45 * i], ch, dir);
   return true;
 }
 

@@ -12,8 +12,6 @@ namespace iesrgs::raster::cpu::IESRGS_CPU_ISA_NAMESPACE {
 
 namespace {
 
-constexpr int kShFloats = 3 * gs::kShCoefficients;
-
 // Number of fields of a struct made of T only (Splat, SplatGrad, SplatBounds, GaussianRowGrad).
 template <template <typename> class Struct>
 constexpr int field_count() {
@@ -70,13 +68,14 @@ RasterCamera<FloatLanes> lanes_camera(const RasterCamera<float>& cam) {
 
 // Gaussians index[0..kFloatLanes) of g, one per lane; only the active SH bands are read.
 struct RowLanes {
-  FloatLanes mean[3], log_scale[3], quat[4], opacity_logit, filter_std, sh[kShFloats];
+  FloatLanes mean[3], log_scale[3], quat[4], opacity_logit, filter_std, sh_dc[3],
+      sh_rest[gs::kShRestFloats];
   int sh_degree;
   bool antialiased;
 
   RowLanes(const GaussianParams<float>& g, const int* index)
       : sh_degree(g.sh_degree), antialiased(g.antialiased) {
-    const int sh_floats = 3 * gs::sh_count(g.sh_degree);
+    const int rest_floats = 3 * (gs::sh_count(g.sh_degree) - 1);
     for (int l = 0; l < kFloatLanes; ++l) {
       const int i = index[l];
       for (int k = 0; k < 3; ++k) mean[k].v[l] = g.means[3 * i + k];
@@ -84,7 +83,8 @@ struct RowLanes {
       for (int k = 0; k < 4; ++k) quat[k].v[l] = g.quats[4 * i + k];
       opacity_logit.v[l] = g.opacity_logits[i];
       filter_std.v[l] = g.filter_std ? g.filter_std[i] : 0.f;
-      for (int k = 0; k < sh_floats; ++k) sh[k].v[l] = g.sh[kShFloats * i + k];
+      for (int k = 0; k < 3; ++k) sh_dc[k].v[l] = g.sh_dc[3 * i + k];
+      for (int k = 0; k < rest_floats; ++k) sh_rest[k].v[l] = g.sh_rest[gs::kShRestFloats * i + k];
     }
   }
 
@@ -94,7 +94,7 @@ struct RowLanes {
             quat,
             opacity_logit,
             filter_std,
-            sh,
+            {sh_dc, sh_rest},
             sh_degree,
             antialiased};
   }

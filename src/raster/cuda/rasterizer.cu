@@ -14,7 +14,8 @@ DeviceGaussians::DeviceGaussians(const GaussianBuffers<float>& host)
       log_scales(host.log_scales),
       quats(host.quats),
       opacity_logits(host.opacity_logits),
-      sh(host.sh),
+      sh_dc(host.sh_dc),
+      sh_rest(host.sh_rest),
       filter_std(host.filter_std) {}
 
 GaussianParams<float> DeviceGaussians::params() const {
@@ -111,8 +112,8 @@ void Rasterizer::backward(const GaussianParams<float>& g, const PixelGrads<float
   State& s = *state_;
   if (g.count != s.count)
     fail("rasterizer: backward got {} Gaussians, forward rendered {}", g.count, s.count);
-  if (g.count > 0 &&
-      !(grads.means && grads.log_scales && grads.quats && grads.opacity_logits && grads.sh))
+  if (g.count > 0 && !(grads.means && grads.log_scales && grads.quats && grads.opacity_logits &&
+                       grads.sh_dc && grads.sh_rest))
     fail("CUDA rasterizer: a parameter gradient array is missing");
   const size_t n = size_t(g.count);
   for (const GradArray<float>& a : grad_arrays(grads, n))

@@ -21,7 +21,8 @@ struct DeviceGaussians {
 
   int sh_degree;
   bool antialiased;
-  iesrgs::cuda::DeviceArray<float> means, log_scales, quats, opacity_logits, sh, filter_std;
+  iesrgs::cuda::DeviceArray<float> means, log_scales, quats, opacity_logits, sh_dc, sh_rest,
+      filter_std;
 };
 
 // Renders frames and their backward passes; keeps the device buffers of the latest frame, which

@@ -51,7 +51,8 @@ struct Frame {
 };
 
 struct Grads {
-  std::vector<float> means, log_scales, quats, opacity_logits, sh, viewspace, viewspace_abs;
+  std::vector<float> means, log_scales, quats, opacity_logits, sh_dc, sh_rest, viewspace,
+      viewspace_abs;
 };
 
 struct PixelGradsHost {
@@ -70,13 +71,10 @@ PixelGradsHost random_pixel_grads(int width, int height, uint32_t seed) {
 }
 
 Grads sized_grads(size_t n) {
-  return {std::vector<float>(3 * n),
-          std::vector<float>(3 * n),
-          std::vector<float>(4 * n),
-          std::vector<float>(n),
-          std::vector<float>(3 * gs::kShCoefficients * n),
-          std::vector<float>(2 * n),
-          std::vector<float>(2 * n)};
+  return {std::vector<float>(3 * n), std::vector<float>(3 * n),
+          std::vector<float>(4 * n), std::vector<float>(n),
+          std::vector<float>(3 * n), std::vector<float>(gs::kShRestFloats * n),
+          std::vector<float>(2 * n), std::vector<float>(2 * n)};
 }
 
 void render_cpu(const GaussianCloud& cloud, const RasterCamera<float>& cam, const float bg[3],
@@ -92,8 +90,8 @@ void render_cpu(const GaussianCloud& cloud, const RasterCamera<float>& cam, cons
   rasterize_backward(cloud.params(), frame,
                      PixelGrads<float>{dpix.image.data(), dpix.alpha.data(), dpix.depth.data()},
                      GaussianGrads<float>{g.means.data(), g.log_scales.data(), g.quats.data(),
-                                          g.opacity_logits.data(), g.sh.data(), g.viewspace.data(),
-                                          g.viewspace_abs.data()});
+                                          g.opacity_logits.data(), g.sh_dc.data(), g.sh_rest.data(),
+                                          g.viewspace.data(), g.viewspace_abs.data()});
 }
 
 void render_cuda(Rasterizer& rasterizer, const GaussianCloud& cloud, const RasterCamera<float>& cam,
@@ -108,15 +106,16 @@ void render_cuda(Rasterizer& rasterizer, const GaussianCloud& cloud, const Raste
   const DeviceArray<float> dimage(dpix.image), dalpha(dpix.alpha), ddepth(dpix.depth);
   const Grads sizes = sized_grads(n);
   DeviceArray<float> means(sizes.means), scales(sizes.log_scales), quats(sizes.quats),
-      logits(sizes.opacity_logits), sh(sizes.sh), vs(sizes.viewspace), vs_abs(sizes.viewspace_abs);
+      logits(sizes.opacity_logits), sh_dc(sizes.sh_dc), sh_rest(sizes.sh_rest), vs(sizes.viewspace),
+      vs_abs(sizes.viewspace_abs);
   rasterizer.backward(scene.params(),
                       PixelGrads<float>{dimage.data(), dalpha.data(), ddepth.data()},
                       GaussianGrads<float>{means.data(), scales.data(), quats.data(), logits.data(),
-                                           sh.data(), vs.data(), vs_abs.data()});
+                                           sh_dc.data(), sh_rest.data(), vs.data(), vs_abs.data()});
   rasterizer.synchronize();
   f = {image.download(), alpha.download(), depth.download(), radii.download()};
-  g = {means.download(), scales.download(), quats.download(), logits.download(),
-       sh.download(),    vs.download(),     vs_abs.download()};
+  g = {means.download(), scales.download(),  quats.download(), logits.download(),
+       sh_dc.download(), sh_rest.download(), vs.download(),    vs_abs.download()};
 }
 
 // Where a splat's alpha lies within rounding of the 1/255 cut-off, or a pixel's transmittance
@@ -161,7 +160,8 @@ void expect_same(const GaussianCloud& cloud, const RasterCamera<float>& cam, con
                 {"log_scales", dgpu.log_scales, dcpu.log_scales},
                 {"quats", dgpu.quats, dcpu.quats},
                 {"opacity_logits", dgpu.opacity_logits, dcpu.opacity_logits},
-                {"sh", dgpu.sh, dcpu.sh},
+                {"sh_dc", dgpu.sh_dc, dcpu.sh_dc},
+                {"sh_rest", dgpu.sh_rest, dcpu.sh_rest},
                 {"viewspace", dgpu.viewspace, dcpu.viewspace},
                 {"viewspace_abs", dgpu.viewspace_abs, dcpu.viewspace_abs}};
   for (const auto& arr : arrays) {
@@ -236,7 +236,7 @@ TEST_F(CudaRasterizer, RejectsABackwardPassForAnotherScene) {
   DeviceArray<float> grads;
   float* d = grads.reserve(48 * 101);
   EXPECT_THROW(rasterizer.backward(other.params(), PixelGrads<float>{},
-                                   GaussianGrads<float>{d, d, d, d, d, nullptr, nullptr}),
+                                   GaussianGrads<float>{d, d, d, d, d, d, nullptr, nullptr}),
                Error);
 }
 
