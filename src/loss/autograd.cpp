@@ -219,6 +219,21 @@ at::Tensor pearson_from_ops(const at::Tensor& a, const at::Tensor& b, const at::
   return at::where(defined, correlation, at::zeros_like(correlation)).to(a.scalar_type());
 }
 
+at::Tensor photometric_autograd(const at::Tensor& render, const at::Tensor& target,
+                                double dssim_weight) {
+  check_pair("photometric loss", render, target);
+  chw_shape(render, "photometric loss");
+  if (!render.device().is_cpu()) {
+    require_ssim_kernel_for(render, "photometric loss");
+    const at::Tensor l1 = (render - target).abs().mean();
+    return (1 - dssim_weight) * l1 + dssim_weight * (1 - ssim_autograd(render, target).mean);
+  }
+  // The guided loss with the whole share on the target: the same per-pixel terms in one pass.
+  return guided_texture_autograd(render, at::Tensor(), target,
+                                 at::zeros(render.sizes().slice(1), render.options()),
+                                 dssim_weight);
+}
+
 at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& internal,
                                    const at::Tensor& external, const at::Tensor& internal_share,
                                    double dssim_weight) {

@@ -31,6 +31,12 @@ at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b,
 // the host. `mask` is defined.
 at::Tensor pearson_from_ops(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
 
+// 3DGS's photometric loss (1 - w) * L1 + w * (1 - SSIM) of a render (C, H, W) against a target,
+// differentiable in render. On the CPU one call of the hand-written kernels, which also computes
+// the gradient; on a GPU tensor ops around the SSIM kernel.
+at::Tensor photometric_autograd(const at::Tensor& render, const at::Tensor& target,
+                                double dssim_weight);
+
 // The fusion stage's texture loss (loss/texture_fusion.hpp) of a render (C, H, W) against the
 // internal and external references, `internal_share` (H, W) choosing between them per pixel. A
 // reference whose share is zero everywhere may be undefined (the internal one for E alone, the

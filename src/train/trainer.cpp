@@ -50,13 +50,6 @@ class InterruptScope {
   void (*previous_)(int);
 };
 
-torch::Tensor photometric_loss(const torch::Tensor& image, const torch::Tensor& target,
-                               double dssim_weight) {
-  const torch::Tensor l1 = (image - target).abs().mean();
-  const torch::Tensor ssim = loss::ssim_autograd(image, target).mean;
-  return (1 - dssim_weight) * l1 + dssim_weight * (1 - ssim);
-}
-
 torch::Tensor bytes_tensor(const std::string& bytes) {
   return torch::from_blob(const_cast<char*>(bytes.data()), {int64_t(bytes.size())}, torch::kUInt8)
       .clone();
@@ -226,7 +219,7 @@ double Trainer::step(int64_t iteration) {
                        setup_.background, probes);
     const torch::Tensor loss =
         setup_.loss ? setup_.loss(v, render)
-                    : photometric_loss(render.image, view.target, config_.dssim_weight);
+                    : loss::photometric_autograd(render.image, view.target, config_.dssim_weight);
     // Backward per view: the gradient of the sum without holding K render graphs at once.
     loss.backward();
     sum += loss.detach().to(torch::kFloat64);

@@ -248,6 +248,39 @@ std::vector<at::Tensor> texture_shares(int64_t height, int64_t width, at::Scalar
           torch::zeros({height, width}, dtype)};
 }
 
+// 3DGS's photometric loss written with torch ops around the SSIM of 3DGS's Python.
+at::Tensor torch_ops_photometric(const at::Tensor& x, const at::Tensor& y, double dssim_weight) {
+  return (1 - dssim_weight) * (x - y).abs().mean() +
+         dssim_weight * (1 - torch_ops_ssim(x, y).first);
+}
+
+TEST(PhotometricAutograd, KernelMatchesTorchOps) {
+  const Images images = random_images(at::kDouble);
+  const at::Tensor x = images.x.clone().requires_grad_(true);
+  const at::Tensor y = images.x.clone().requires_grad_(true);
+  const at::Tensor kernel = photometric_autograd(x, images.y, 0.2);
+  const at::Tensor ops = torch_ops_photometric(y, images.y, 0.2);
+  (3 * kernel).backward();
+  (3 * ops).backward();
+  EXPECT_LT(max_difference(ops, kernel), 1e-12);
+  EXPECT_LT(max_difference(y.grad(), x.grad()), 1e-12);
+  EXPECT_EQ(testing::error_message([&] { photometric_autograd(x[0], images.y[0], 0.2); }),
+            "photometric loss: image shape [23, 31] is not (C, H, W)");
+}
+
+TEST(PhotometricAutograd, CudaMatchesCpu) {
+  IESRGS_SKIP_WITHOUT_CUDA();
+  const Images images = random_images(at::kFloat);
+  const at::Tensor x = images.x.clone().requires_grad_(true);
+  const at::Tensor x_gpu = images.x.to(torch::kCUDA).requires_grad_(true);
+  const at::Tensor expected = photometric_autograd(x, images.y, 0.2);
+  const at::Tensor actual = photometric_autograd(x_gpu, images.y.to(torch::kCUDA), 0.2);
+  expected.backward();
+  actual.backward();
+  EXPECT_LT(max_difference(actual.cpu(), expected), 1e-6);
+  EXPECT_LT(testing::relative_difference(x_gpu.grad(), x.grad()), 1e-5);
+}
+
 TEST(GuidedTextureAutograd, TensorOpsMatchTheKernel) {
   const Images images = random_images(at::kDouble);
   const at::Tensor external = (images.y + 0.1 * torch::rand_like(images.y)).clamp(0, 1);

@@ -148,8 +148,7 @@ TEST_F(TrainerTest, InterruptedRunResumesToTheSameModel) {
       std::raise(SIGINT);
     }
     const torch::Tensor& target = s.train_views[size_t(view)].target;
-    return 0.8 * (render.image - target).abs().mean() +
-           0.2 * (1 - loss::ssim_autograd(render.image, target).mean);
+    return loss::photometric_autograd(render.image, target, 0.2);
   };
   TrainerSetup interrupted_setup = s;
   interrupted_setup.loss = photometric;
