@@ -185,18 +185,15 @@ class ForwardBox {
     const MomentRows<T> stats{s, s + width, s + 2 * width, s + 3 * width};
     rows_.sub_window_moments(window<T>().tap, rows[0], rows[1], rows[2], rows[3], width, stats);
 
-    // Value then the kPartialPlanes derivatives, one row each.
+    // Value then the kPartialPlanes derivatives, one row each; the derivatives straight into
+    // the partials when the backward pass wants them.
     T* values = points_.data();
-    T* d_mean = values + width;
-    T* d_square = d_mean + width;
-    T* d_cross = d_square + width;
-    rows_.points(stats, width, values, d_mean, d_square, d_cross);
-    if (partials_) {
-      const size_t offset = row_offset(shape_, c, r) + box_.col0;
-      for (int plane = 0; plane < kPartialPlanes; ++plane)
-        std::copy_n(d_mean + size_t(plane) * width, width,
-                    partials_ + plane * shape_.values() + offset);
-    }
+    T* d[kPartialPlanes];
+    for (int plane = 0; plane < kPartialPlanes; ++plane)
+      d[plane] = partials_
+                     ? partials_ + plane * shape_.values() + row_offset(shape_, c, r) + box_.col0
+                     : values + size_t(1 + plane) * width;
+    rows_.points(stats, width, values, d[0], d[1], d[2]);
     if (map_) {
       const T inv_channels = T(1) / shape_.channels;
       T* map_row = map_ + size_t(r) * shape_.width + box_.col0;
