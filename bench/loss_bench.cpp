@@ -48,10 +48,11 @@ void BM_SsimForwardBackward(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * int64_t(c.shape.pixels()));
 }
 
-// HR views of the x4 protocol (800x800) and their LR inputs (200x200).
+// HR views of the x4 protocol (800x800) and their LR inputs (200x200), and the HR views of the
+// CPU-scale runs (400x400), where the texture loss below runs.
 void ssim_sizes(benchmark::internal::Benchmark* b) {
   b->ArgNames({"side", "threads"});
-  for (int side : {800, 200})
+  for (int side : {800, 400, 200})
     for (int threads : {1, 2}) b->Args({side, threads});
 }
 

@@ -174,7 +174,9 @@ class GuidedTextureFunction : public torch::autograd::Function<GuidedTextureFunc
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
-    const at::Tensor grad = ctx->get_saved_variables()[0] * grads[0];
+    at::Tensor grad = ctx->get_saved_variables()[0];
+    // A training step's upstream gradient is 1: no product image to allocate and fill.
+    if (grads[0].item<double>() != 1) grad = grad * grads[0];
     return {grad, at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
   }
 };

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "loss/reused_buffer.hpp"
 #include "loss/ssim.hpp"
 
 namespace iesrgs::loss {
@@ -23,24 +24,10 @@ T pixel_l1(const T* x, const T* y, const ImageShape& shape, size_t p) {
   return sum / shape.channels;
 }
 
-// n values of T that stay allocated for the thread's next call with the same Slot: SSIM's partials
-// are megabytes per image, which a fresh zeroed vector would page in and clear at every step.
-template <typename T, typename Slot>
-T* reused_buffer(size_t n) {
-  thread_local std::vector<T> buffer;
-  if (buffer.size() < n) buffer.resize(n);
-  return buffer.data();
-}
-
 struct SsimMapSlot;
 struct SsimPartialsSlot;
-
-template <typename T>
-std::vector<T> scaled(const T* weight, size_t count, double factor) {
-  std::vector<T> out(count);
-  for (size_t i = 0; i < count; ++i) out[i] = T(factor * weight[i]);
-  return out;
-}
+struct L1WeightSlot;
+struct SsimWeightSlot;
 
 }  // namespace
 
@@ -112,12 +99,19 @@ double weighted_photometric_loss(const T* x, const T* y, const ImageShape& shape
     sum += double(weight[p]) * ((1 - lambda) * l1 + lambda * (1 - double(ssim_map[p])));
   }
   if (grad_x) {
-    l1_backward(x, y, shape, scaled(weight, pixels, 1 - lambda).data(), grad_x);
-    const std::vector<T> ssim_weight = scaled(weight, pixels, -lambda);
+    // The weights of the two terms' maps, in one pass over the pixels.
+    T* l1_weight = reused_buffer<T, L1WeightSlot>(pixels);
+    T* ssim_weight = reused_buffer<T, SsimWeightSlot>(pixels);
+#pragma omp parallel for
+    for (int64_t p = 0; p < int64_t(pixels); ++p) {
+      l1_weight[p] = T((1 - lambda) * weight[p]);
+      ssim_weight[p] = T(-lambda * weight[p]);
+    }
+    l1_backward(x, y, shape, l1_weight, grad_x);
     if (sparse)
-      ssim_backward_in(x, y, shape, support.reached, partials, ssim_weight.data(), grad_x);
+      ssim_backward_in(x, y, shape, support.reached, partials, ssim_weight, grad_x);
     else
-      ssim_backward(x, y, shape, partials, ssim_weight.data(), grad_x);
+      ssim_backward(x, y, shape, partials, ssim_weight, grad_x);
   }
   return sum;
 }

@@ -299,6 +299,19 @@ class BackwardBox {
 
 }  // namespace
 
+namespace {
+
+template <typename T>
+bool tile_has_weight(const T* weight, const ImageShape& shape, int tile_row, int tile_col) {
+  const int col0 = tile_col * kSsimTile, col1 = std::min(shape.width, col0 + kSsimTile);
+  for (int r = tile_row * kSsimTile; r < std::min(shape.height, (tile_row + 1) * kSsimTile); ++r)
+    for (int col = col0; col < col1; ++col)
+      if (weight[size_t(r) * shape.width + col] != 0) return true;
+  return false;
+}
+
+}  // namespace
+
 template <typename T>
 SsimSupport ssim_support(const T* weight, const ImageShape& shape) {
   check_shape(shape, "ssim_support");
@@ -314,10 +327,11 @@ SsimSupport ssim_support(const T* weight, const ImageShape& shape) {
     return boxes;
   };
   std::vector<uint8_t> weighted(size_t(tile_rows) * tile_cols, 0);
-  for (int r = 0; r < shape.height; ++r)
-    for (int col = 0; col < shape.width; ++col)
-      if (weight[size_t(r) * shape.width + col] != 0)
-        weighted[size_t(r / kSsimTile) * tile_cols + col / kSsimTile] = 1;
+  // Tile by tile, up to the first nonzero weight: a dense weight is settled by one value per tile.
+#pragma omp parallel for
+  for (int tr = 0; tr < tile_rows; ++tr)
+    for (int tc = 0; tc < tile_cols; ++tc)
+      weighted[size_t(tr) * tile_cols + tc] = tile_has_weight(weight, shape, tr, tc);
   SsimSupport support;
   support.tiles = weighted.size();
   support.weighted = boxes_of(weighted);

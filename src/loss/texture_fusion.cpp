@@ -4,8 +4,14 @@
 
 #include "core/error.hpp"
 #include "loss/photometric.hpp"
+#include "loss/reused_buffer.hpp"
 
 namespace iesrgs::loss {
+
+namespace {
+struct InternalWeightSlot;
+struct ExternalWeightSlot;
+}  // namespace
 
 template <typename T>
 std::vector<T> discrepancy_map(const T* internal, const T* external, const ImageShape& shape) {
@@ -39,25 +45,27 @@ double guided_texture_loss(const T* render, const T* internal, const T* external
                            const T* internal_share, const ImageShape& shape, double lambda,
                            T* grad_render) {
   check_shape(shape, "guided_texture_loss");
-  const size_t pixels = shape.pixels();
+  const int64_t pixels = int64_t(shape.pixels());
   const T mean_weight = T(1.0 / double(pixels));
-  std::vector<T> internal_weight(pixels), external_weight(pixels);
+  T* internal_weight = reused_buffer<T, InternalWeightSlot>(pixels);
+  T* external_weight = reused_buffer<T, ExternalWeightSlot>(pixels);
   bool uses_internal = false, uses_external = false;
-  for (size_t p = 0; p < pixels; ++p) {
+#pragma omp parallel for reduction(|| : uses_internal, uses_external)
+  for (int64_t p = 0; p < pixels; ++p) {
     internal_weight[p] = internal_share[p] * mean_weight;
     external_weight[p] = (1 - internal_share[p]) * mean_weight;
-    uses_internal |= internal_weight[p] != 0;
-    uses_external |= external_weight[p] != 0;
+    uses_internal = uses_internal || internal_weight[p] != 0;
+    uses_external = uses_external || external_weight[p] != 0;
   }
   if (uses_internal && !internal) fail("guided_texture_loss: internal share without an image");
   if (uses_external && !external) fail("guided_texture_loss: external share without an image");
   double loss = 0;
   if (uses_internal)
-    loss += weighted_photometric_loss(render, internal, shape, lambda, internal_weight.data(),
-                                      grad_render);
+    loss +=
+        weighted_photometric_loss(render, internal, shape, lambda, internal_weight, grad_render);
   if (uses_external)
-    loss += weighted_photometric_loss(render, external, shape, lambda, external_weight.data(),
-                                      grad_render);
+    loss +=
+        weighted_photometric_loss(render, external, shape, lambda, external_weight, grad_render);
   return loss;
 }
 
