@@ -302,6 +302,18 @@ TEST(GuidedTextureAutograd, TensorOpsMatchTheKernel) {
             1e-12);
 }
 
+// The backward skips the product with an upstream gradient of 1; any other value scales.
+TEST(GuidedTextureAutograd, UpstreamGradientScalesTheGradient) {
+  const Images images = random_images(at::kDouble);
+  const at::Tensor share = texture_shares(23, 31, at::kDouble)[1];
+  const at::Tensor once = images.x.clone().requires_grad_(true);
+  const at::Tensor scaled = images.x.clone().requires_grad_(true);
+  guided_texture_autograd(once, images.y, images.y, share, 0.2).backward();
+  (-2.5 * guided_texture_autograd(scaled, images.y, images.y, share, 0.2)).backward();
+  EXPECT_GT(once.grad().abs().max().item<double>(), 0);
+  EXPECT_LT(max_difference(scaled.grad(), -2.5 * once.grad()), 1e-15);
+}
+
 TEST(GuidedTextureAutograd, InternalAloneNeedsNoExternalImage) {
   const Images images = random_images(at::kDouble);
   const at::Tensor all_internal = torch::ones({23, 31}, at::kDouble);
