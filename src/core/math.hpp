@@ -25,6 +25,12 @@ struct Vec3 {
   double norm() const { return std::sqrt(dot(*this)); }
 };
 
+// -1, 0 or 1: the derivative of |t| as torch takes it, 0 at t = 0.
+template <typename T>
+T sign(T t) {
+  return T((t > 0) - (t < 0));
+}
+
 inline double sigmoid(double x) {
   return 1 / (1 + std::exp(-x));
 }

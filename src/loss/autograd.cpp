@@ -1,5 +1,6 @@
 #include "loss/autograd.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <type_traits>
@@ -8,6 +9,7 @@
 #include <torch/csrc/autograd/custom_function.h>
 
 #include "core/error.hpp"
+#include "loss/depth_l1.hpp"
 #include "loss/pearson.hpp"
 #include "loss/ssim.hpp"
 #include "loss/texture_fusion.hpp"
@@ -152,6 +154,39 @@ class PearsonFunction : public torch::autograd::Function<PearsonFunction> {
   }
 };
 
+class CoveredDepthL1Function : public torch::autograd::Function<CoveredDepthL1Function> {
+ public:
+  static at::Tensor forward(AutogradContext* ctx, const at::Tensor& depth_in,
+                            const at::Tensor& alpha_in, const at::Tensor& reference_in) {
+    const at::Tensor depth = depth_in.contiguous(), alpha = alpha_in.contiguous();
+    const at::Tensor reference = reference_in.contiguous();
+    const CoveredDepthL1 l1 = with_scalar_type(depth, [&](auto zero) {
+      using T = decltype(zero);
+      return covered_depth_l1<T>(depth.data_ptr<T>(), alpha.data_ptr<T>(), reference.data_ptr<T>(),
+                                 depth.numel());
+    });
+    ctx->save_for_backward({depth, alpha, reference});
+    ctx->saved_data["pixels"] = l1.pixels;
+    return at::scalar_tensor(l1.mean, depth.options());
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const variable_list saved = ctx->get_saved_variables();
+    const at::Tensor &depth = saved[0], &alpha = saved[1], &reference = saved[2];
+    at::Tensor grad_depth = at::empty_like(depth), grad_alpha = at::empty_like(alpha);
+    const int64_t pixels = std::max<int64_t>(ctx->saved_data["pixels"].toInt(), 1);
+    with_scalar_type(depth, [&](auto zero) {
+      using T = decltype(zero);
+      // The upstream gradient over the pixel count, divided in T as autograd divides it.
+      const T scale = grads[0].item<T>() / T(pixels);
+      covered_depth_l1_backward<T>(depth.data_ptr<T>(), alpha.data_ptr<T>(),
+                                   reference.data_ptr<T>(), depth.numel(), scale,
+                                   grad_depth.data_ptr<T>(), grad_alpha.data_ptr<T>());
+    });
+    return {grad_depth, grad_alpha, at::Tensor()};
+  }
+};
+
 class GuidedTextureFunction : public torch::autograd::Function<GuidedTextureFunction> {
  public:
   // An undefined reference travels as an empty tensor: autograd::Function takes defined ones.
@@ -219,6 +254,24 @@ at::Tensor pearson_from_ops(const at::Tensor& a, const at::Tensor& b, const at::
   const at::Tensor defined = (count >= 2) & (xx > 0) & (yy > 0);
   const at::Tensor correlation = (dx * dy).sum() / (xx * yy).clamp_min(1e-300).sqrt();
   return at::where(defined, correlation, at::zeros_like(correlation)).to(a.scalar_type());
+}
+
+at::Tensor covered_depth_l1_autograd(const at::Tensor& depth, const at::Tensor& alpha,
+                                     const at::Tensor& reference) {
+  check_pair("covered depth L1", depth, reference);
+  check_pair("covered depth L1 (alpha)", depth, alpha.detach());
+  if (!depth.device().is_cpu())
+    return covered_depth_l1_from_ops(depth, alpha, reference);  // the kernel reads host memory
+  return CoveredDepthL1Function::apply(depth, alpha, reference);
+}
+
+at::Tensor covered_depth_l1_from_ops(const at::Tensor& depth, const at::Tensor& alpha,
+                                     const at::Tensor& reference) {
+  const at::Tensor counted =
+      ((alpha.detach() >= kDepthCoverageAlpha) & (reference > 0)).to(depth.scalar_type());
+  // The clamp keeps the expected depth finite where alpha vanishes, off the counted pixels.
+  const at::Tensor expected = depth / alpha.clamp_min(1e-6);
+  return ((expected - reference).abs() * counted).sum() / counted.sum().clamp_min(1);
 }
 
 at::Tensor photometric_autograd(const at::Tensor& render, const at::Tensor& target,

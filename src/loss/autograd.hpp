@@ -31,6 +31,17 @@ at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b,
 // the host. `mask` is defined.
 at::Tensor pearson_from_ops(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
 
+// The internal depth term (loss/depth_l1.hpp) of a render's depth and alpha (H, W) against the
+// reference depth (H, W), differentiable in depth and alpha. On the CPU the hand-written kernel;
+// on a GPU covered_depth_l1_from_ops.
+at::Tensor covered_depth_l1_autograd(const at::Tensor& depth, const at::Tensor& alpha,
+                                     const at::Tensor& reference);
+
+// The same composed of tensor ops, which is what tensors on a GPU take; equal in value and
+// gradient, and it reads nothing back to the host.
+at::Tensor covered_depth_l1_from_ops(const at::Tensor& depth, const at::Tensor& alpha,
+                                     const at::Tensor& reference);
+
 // 3DGS's photometric loss (1 - w) * L1 + w * (1 - SSIM) of a render (C, H, W) against a target,
 // differentiable in render. On the CPU one call of the hand-written kernels, which also computes
 // the gradient; on a GPU tensor ops around the SSIM kernel.

@@ -23,16 +23,6 @@ torch::Tensor map_tensor(const std::vector<T>& values, const ImageShape& shape,
       .to(torch::kFloat);
 }
 
-// L1 between the render's expected depth and I_depth where both saw a surface: the mean over those
-// pixels, 0 where there are none, without reading their count back to the host.
-torch::Tensor internal_depth_loss(const raster::RenderOutput& render,
-                                  const torch::Tensor& internal_depth,
-                                  const torch::Tensor& covered) {
-  const torch::Tensor valid = (covered & (internal_depth > 0)).to(render.depth.scalar_type());
-  const torch::Tensor expected = render.depth / render.alpha.clamp_min(1e-6);
-  return ((expected - internal_depth).abs() * valid).sum() / valid.sum().clamp_min(1);
-}
-
 // 1 - corr(rendered inverse depth, E_depth) over the covered pixels, as SparseGS relaxes depth.
 torch::Tensor external_depth_loss(const raster::RenderOutput& render,
                                   const torch::Tensor& disparity, const torch::Tensor& covered) {
@@ -114,16 +104,14 @@ FusionLossTerms fusion_loss(const raster::RenderOutput& render, const FusionTarg
       reference(uses_external, targets.external_image, "external"), targets.internal_share,
       weights.dssim_weight);
   terms.texture = terms.total.detach();
-  const bool internal_depth = weights.internal_depth > 0 && targets.internal_depth.defined();
-  const bool external_depth = weights.external_depth > 0 && targets.external_disparity.defined();
-  if (!internal_depth && !external_depth) return terms;
-  const torch::Tensor covered = render.alpha.detach() >= kDepthCoverageAlpha;
-  if (internal_depth) {
-    const torch::Tensor l = internal_depth_loss(render, targets.internal_depth, covered);
+  if (weights.internal_depth > 0 && targets.internal_depth.defined()) {
+    const torch::Tensor l =
+        covered_depth_l1_autograd(render.depth, render.alpha, targets.internal_depth);
     terms.internal_depth = l.detach();
     terms.total = terms.total + weights.internal_depth * l;
   }
-  if (external_depth) {
+  if (weights.external_depth > 0 && targets.external_disparity.defined()) {
+    const torch::Tensor covered = render.alpha.detach() >= kDepthCoverageAlpha;
     const torch::Tensor l = external_depth_loss(render, targets.external_disparity, covered);
     terms.external_depth = l.detach();
     terms.total = terms.total + weights.external_depth * l;

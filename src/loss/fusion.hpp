@@ -7,6 +7,7 @@
 
 #include <string>
 
+#include "loss/depth_l1.hpp"
 #include "raster/autograd.hpp"
 
 namespace iesrgs::loss {
@@ -49,9 +50,6 @@ torch::Tensor discrepancy(const torch::Tensor& internal_image, const torch::Tens
 // The per-pixel internal share of `guidance`; the mask M(p) = [D(p) >= threshold] for Masked.
 torch::Tensor internal_share(TextureGuidance guidance, const torch::Tensor& internal_image,
                              const torch::Tensor& external_image, double threshold);
-
-// Pixels whose render covers them (alpha >= 0.5), the only ones the depth terms look at.
-constexpr double kDepthCoverageAlpha = 0.5;
 
 // Scalar tensors where the render is: nothing here is read back to the host, which would make a
 // GPU wait for every step.

@@ -4,16 +4,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/math.hpp"
 #include "loss/reused_buffer.hpp"
 #include "loss/ssim.hpp"
 
 namespace iesrgs::loss {
 namespace {
-
-template <typename T>
-T sign(T t) {
-  return T((t > 0) - (t < 0));
-}
 
 // Mean over channels of |x - y| at pixel p.
 template <typename T>

@@ -241,6 +241,54 @@ TEST(PearsonAutograd, TensorOpsMatchTheKernel) {
   }
 }
 
+// A render's depth and alpha, some pixels under-covered, and a reference with holes (0).
+struct DepthMaps {
+  at::Tensor depth, alpha, reference;
+};
+
+DepthMaps depth_maps(at::ScalarType dtype) {
+  torch::manual_seed(5);
+  const at::Tensor alpha = torch::rand({17, 13}, dtype);
+  const at::Tensor depth = alpha * (2 + 3 * torch::rand({17, 13}, dtype));
+  const at::Tensor reference =
+      (2 + 3 * torch::rand({17, 13}, dtype)) * (torch::rand({17, 13}) > 0.2).to(dtype);
+  return {depth, alpha, reference};
+}
+
+// Value and gradients (depth, alpha) of li times the term, by the kernel or the tensor ops.
+std::vector<at::Tensor> depth_l1_with_gradients(bool ops, const DepthMaps& maps) {
+  const at::Tensor depth = maps.depth.clone().requires_grad_(true);
+  const at::Tensor alpha = maps.alpha.clone().requires_grad_(true);
+  const at::Tensor l1 = ops ? covered_depth_l1_from_ops(depth, alpha, maps.reference)
+                            : covered_depth_l1_autograd(depth, alpha, maps.reference);
+  (1e-3 * l1).backward();
+  return {l1.detach(), depth.grad(), alpha.grad()};
+}
+
+TEST(CoveredDepthL1Autograd, KernelMatchesTensorOps) {
+  const std::vector<at::Tensor> kernel = depth_l1_with_gradients(false, depth_maps(at::kDouble));
+  const std::vector<at::Tensor> ops = depth_l1_with_gradients(true, depth_maps(at::kDouble));
+  EXPECT_GT(kernel[0].item<double>(), 0);
+  EXPECT_GT(kernel[2].abs().max().item<double>(), 0);
+  for (int i = 0; i < 3; ++i) EXPECT_LT(max_difference(kernel[i], ops[i]), 1e-12) << i;
+}
+
+// Training in float takes the same steps with the kernel as with the tensor ops.
+TEST(CoveredDepthL1Autograd, FloatGradientIsTheTensorOpsToTheBit) {
+  const std::vector<at::Tensor> kernel = depth_l1_with_gradients(false, depth_maps(at::kFloat));
+  const std::vector<at::Tensor> ops = depth_l1_with_gradients(true, depth_maps(at::kFloat));
+  EXPECT_LT(max_difference(kernel[0], ops[0]), 1e-6);
+  EXPECT_TRUE(torch::equal(kernel[1], ops[1]));
+  EXPECT_TRUE(torch::equal(kernel[2], ops[2]));
+}
+
+TEST(CoveredDepthL1Autograd, MismatchedShapesAreRefused) {
+  const DepthMaps maps = depth_maps(at::kFloat);
+  const std::string message = testing::error_message(
+      [&] { covered_depth_l1_autograd(maps.depth, maps.alpha, maps.reference.t()); });
+  EXPECT_NE(message.find("covered depth L1"), std::string::npos) << message;
+}
+
 // The share maps of the fusion rows: the mask M (IE-SRGS), both references averaged, E alone.
 std::vector<at::Tensor> texture_shares(int64_t height, int64_t width, at::ScalarType dtype) {
   torch::manual_seed(7);
