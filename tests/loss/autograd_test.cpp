@@ -282,6 +282,17 @@ TEST(CoveredDepthL1Autograd, FloatGradientIsTheTensorOpsToTheBit) {
   EXPECT_TRUE(torch::equal(kernel[2], ops[2]));
 }
 
+// Device tensors take the tensor-ops version.
+TEST(CoveredDepthL1Autograd, CudaTensorsGiveTheCpuResult) {
+  IESRGS_SKIP_WITHOUT_CUDA();
+  const DepthMaps maps = depth_maps(at::kFloat);
+  const DepthMaps on_gpu{maps.depth.cuda(), maps.alpha.cuda(), maps.reference.cuda()};
+  const std::vector<at::Tensor> cpu = depth_l1_with_gradients(false, maps);
+  const std::vector<at::Tensor> gpu = depth_l1_with_gradients(false, on_gpu);
+  EXPECT_TRUE(gpu[0].is_cuda());
+  for (int i = 0; i < 3; ++i) EXPECT_LT(max_difference(gpu[i].cpu(), cpu[i]), 1e-6) << i;
+}
+
 TEST(CoveredDepthL1Autograd, MismatchedShapesAreRefused) {
   const DepthMaps maps = depth_maps(at::kFloat);
   const std::string message = testing::error_message(
