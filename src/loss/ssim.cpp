@@ -297,10 +297,6 @@ class BackwardBox {
   std::vector<T> padded_, blurred_;
 };
 
-}  // namespace
-
-namespace {
-
 template <typename T>
 bool tile_has_weight(const T* weight, const ImageShape& shape, int tile_row, int tile_col) {
   const int col0 = tile_col * kSsimTile, col1 = std::min(shape.width, col0 + kSsimTile);
