@@ -44,20 +44,28 @@ struct RowSpec {
   Source source;
   TextureGuidance texture;
   bool internal_depth, external_depth;
+  // The mask from the HR truth instead of D: the internal image wherever it is the closer
+  // reference. What IE-SRGS would reach with a perfect mask; benchmarks only.
+  bool oracle_mask;
 };
 
 constexpr RowSpec kRows[] = {
-    {"bicubic", "bicubic-3DGS", Source::Bicubic, TextureGuidance::External, false, false},
+    {"bicubic", "bicubic-3DGS", Source::Bicubic, TextureGuidance::External, false, false, false},
     {"internal", "internal only (LR Mip-Splatting at HR)", Source::Internal,
-     TextureGuidance::External, false, false},
+     TextureGuidance::External, false, false, false},
     {"external", "external only (2D SR -> 3DGS)", Source::SuperResolved, TextureGuidance::External,
-     false, false},
-    {"external-depth", "+ E_depth", Source::SuperResolved, TextureGuidance::External, false, true},
+     false, false, false},
+    {"external-depth", "+ E_depth", Source::SuperResolved, TextureGuidance::External, false, true,
+     false},
     {"joint", "+ I_image (averaged, no mask)", Source::SuperResolved, TextureGuidance::Average,
-     false, true},
-    {"joint-depth", "+ I_depth", Source::SuperResolved, TextureGuidance::Average, true, true},
-    {"ie-srgs", "IE-SRGS (+ mask)", Source::SuperResolved, TextureGuidance::Masked, true, true},
-    {"hr", "HR upper bound", Source::HighRes, TextureGuidance::External, false, false},
+     false, true, false},
+    {"joint-depth", "+ I_depth", Source::SuperResolved, TextureGuidance::Average, true, true,
+     false},
+    {"ie-srgs", "IE-SRGS (+ mask)", Source::SuperResolved, TextureGuidance::Masked, true, true,
+     false},
+    {"mask-oracle", "IE-SRGS with the oracle mask (from the HR truth)", Source::SuperResolved,
+     TextureGuidance::Masked, true, true, true},
+    {"hr", "HR upper bound", Source::HighRes, TextureGuidance::External, false, false, false},
 };
 
 const RowSpec* find_row(const std::string& id) {
@@ -118,6 +126,7 @@ class Pipeline {
 
  private:
   bool any_row(Source source) const;
+  bool any_oracle_row() const;
   bool row_uses_internal(const RowSpec& row) const;
   bool rows_use_internal_references() const;
   void check_cached_inputs() const;
@@ -139,6 +148,8 @@ class Pipeline {
   // The HR ground truth of training view i, (3, H, W); undefined when the run has none at
   // `camera`'s size.
   torch::Tensor train_truth(size_t i, const Camera& camera) const;
+  // The oracle mask of training view i of `setup`, (H, W) float, as the internal share.
+  torch::Tensor oracle_share(size_t i, const FusionSetup& setup) const;
 
   RunOptions o_;
   std::vector<std::string> rows_;
@@ -170,8 +181,10 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
   threshold_ = o_.threshold >= 0     ? o_.threshold
                : lr_scene_.synthetic ? loss::kDiscrepancyThresholdSynthetic
                                      : loss::kDiscrepancyThresholdReal;
-  if (o_.input_is_lr && any_row(Source::HighRes))
-    fail("the hr row needs HR images, which a low-resolution input (--input-is-lr) lacks");
+  if (o_.input_is_lr && (any_row(Source::HighRes) || any_oracle_row()))
+    fail(
+        "the hr and mask-oracle rows need HR images, which a low-resolution input "
+        "(--input-is-lr) lacks");
   train_digest_ = split_digest(*lr_images_, Split::Train);
   test_digest_ = split_digest(hr_images_ ? *hr_images_ : *lr_images_, Split::Test);
 }
@@ -179,6 +192,12 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
 bool Pipeline::any_row(Source source) const {
   for (const std::string& id : rows_)
     if (row_spec(id).source == source) return true;
+  return false;
+}
+
+bool Pipeline::any_oracle_row() const {
+  for (const std::string& id : rows_)
+    if (row_spec(id).oracle_mask) return true;
   return false;
 }
 
@@ -293,6 +312,7 @@ FusionSetup Pipeline::fusion_setup(const RowSpec& row, const loss::FusionWeights
       files.internal_depth = internal_->sr_dir / "depth" / (name + ".npy");
     }
     setup.targets.push_back(load_fusion_targets(files, setup.cameras[i], weights, threshold_));
+    if (row.oracle_mask) setup.targets.back().internal_share = oracle_share(i, setup);
   }
   return setup;
 }
@@ -382,6 +402,16 @@ void Pipeline::write_fusion_diagnostics(const gs::GaussianModel& model,
   write_diagnostics(o_.output / "diagnostics", views, threshold_);
 }
 
+torch::Tensor Pipeline::oracle_share(size_t i, const FusionSetup& setup) const {
+  const Camera& camera = setup.cameras[i];
+  const torch::Tensor truth = train_truth(i, camera);
+  if (!truth.defined())
+    fail("view {}: the mask-oracle row needs the HR truth at the HR camera's size, {}x{}",
+         camera.name, camera.intrinsics.width, camera.intrinsics.height);
+  const loss::FusionTargets& targets = setup.targets[i];
+  return eval::oracle_mask(targets.internal_image, targets.external_image, truth).to(torch::kFloat);
+}
+
 torch::Tensor Pipeline::train_truth(size_t i, const Camera& camera) const {
   if (!hr_scene_) return {};
   const Camera& truth_camera = *hr_scene_->split(Split::Train)[i];
@@ -410,7 +440,9 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
                                {"internal_closer_share", counts.internal_closer_share()},
                                {"psnr_external", counts.external_psnr()},
                                {"psnr_internal", counts.internal_psnr()},
-                               {"psnr_fused", counts.fused_psnr()}};
+                               {"psnr_fused", counts.fused_psnr()},
+                               {"oracle_mask_share", counts.oracle_mask_share()},
+                               {"psnr_oracle", counts.oracle_psnr()}};
   const fs::path path = o_.output / "diagnostics" / "mask_agreement.json";
   write_file_atomically(path, json.dump(2) + "\n");
   fmt::print(
@@ -418,10 +450,11 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
       "precision {:.3f}, recall {:.3f}; the internal image is the closer one at {:.1f}% of M "
       "({})\n"
       "references against the HR truth: E_image {:.2f} dB, I_image {:.2f} dB, fused by M {:.2f} "
-      "dB\n",
+      "dB, by the oracle mask ({:.1f}% of the pixels) {:.2f} dB\n",
       100 * counts.mask_share(), 100 * counts.truth_mask_share(), counts.iou(), counts.precision(),
       counts.recall(), 100 * counts.internal_closer_share(), path.string(), counts.external_psnr(),
-      counts.internal_psnr(), counts.fused_psnr());
+      counts.internal_psnr(), counts.fused_psnr(), 100 * counts.oracle_mask_share(),
+      counts.oracle_psnr());
 }
 
 RunResult Pipeline::run() {
@@ -537,7 +570,7 @@ std::vector<std::string> expand_rows(const std::vector<std::string>& names) {
   for (const std::string& name : names) {
     for (size_t i = 0; i < std::size(kRows); ++i) {
       const std::string id = kRows[i].id;
-      const bool ablation = id != "bicubic" && id != "hr";
+      const bool ablation = id != "bicubic" && id != "hr" && id != "mask-oracle";
       const bool demo = id == "bicubic" || id == "internal" || id == "external" || id == "ie-srgs";
       if (name == id || name == "all" || (name == "ablation" && ablation) ||
           (name == "demo" && demo))

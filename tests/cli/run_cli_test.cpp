@@ -32,19 +32,20 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
   const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
   ASSERT_EQ(iesrgs("synth -o " + scene + " --size 48 --views 6 --test-views 2 --seed 3").status, 0);
   const std::string command =
-      "run " + scene + " -o " + out + " --rows demo,hr,joint" + kTinySchedule;
+      "run " + scene + " -o " + out + " --rows demo,hr,joint,mask-oracle" + kTinySchedule;
   const CliRun first = iesrgs(command);
   ASSERT_EQ(first.status, 0) << first.output;
   EXPECT_TRUE(contains(first.output, "IE-SRGS (+ mask)")) << first.output;
 
   const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
-  ASSERT_EQ(results["rows"].size(), 6u);
+  ASSERT_EQ(results["rows"].size(), 7u);
   for (const auto& row : results["rows"]) {
     EXPECT_GT(row["psnr"].get<double>(), 8.0) << row.dump();
     EXPECT_GT(row["fps"].get<double>(), 0.0) << row.dump();
   }
   EXPECT_EQ(results["rows"][0]["row"], "bicubic");
-  EXPECT_EQ(results["rows"][5]["row"], "hr");
+  EXPECT_EQ(results["rows"][5]["row"], "mask-oracle");
+  EXPECT_EQ(results["rows"][6]["row"], "hr");
   EXPECT_TRUE(results["stages"].contains("internal_training_seconds"));
   for (const char* file :
        {"results.csv", "results.md", "external/image/r_0.png", "bicubic/image/r_0.png",
@@ -56,9 +57,10 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
   const auto agreement =
       nlohmann::json::parse(read_file(dir / "run" / "diagnostics/mask_agreement.json"));
   EXPECT_EQ(agreement["views"], 6);
-  for (const char* key : {"mask_share", "truth_mask_share", "iou", "internal_closer_share"})
+  for (const char* key :
+       {"mask_share", "truth_mask_share", "iou", "internal_closer_share", "oracle_mask_share"})
     EXPECT_TRUE(agreement[key].get<double>() >= 0 && agreement[key].get<double>() <= 1) << key;
-  for (const char* key : {"psnr_external", "psnr_internal", "psnr_fused"})
+  for (const char* key : {"psnr_external", "psnr_internal", "psnr_fused", "psnr_oracle"})
     EXPECT_GT(agreement[key].get<double>(), 8.0) << key;
   const ImageHeader render = read_image_header(dir / "run" / "rows/ie-srgs/test/rgb/r_0.png");
   EXPECT_EQ(render.width, 48);
@@ -89,7 +91,8 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
     return rows;
   };
   const Table kept = {{"bicubic", true}, {"internal", true}, {"external", false},
-                      {"joint", true},   {"ie-srgs", true},  {"hr", true}};
+                      {"joint", true},   {"ie-srgs", true},  {"mask-oracle", true},
+                      {"hr", true}};
   EXPECT_EQ(table(), kept);
   EXPECT_TRUE(contains(read_file(dir / "run" / "results.md"), "from an earlier run"));
 
@@ -158,10 +161,12 @@ TEST(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
   ASSERT_EQ(results["rows"].size(), 1u);
   EXPECT_FALSE(results["rows"][0].contains("psnr"));
 
-  const CliRun hr =
-      iesrgs("run " + scene + " -o " + out + " --input-is-lr --rows hr" + kTinySchedule);
-  EXPECT_EQ(hr.status, 1);
-  EXPECT_TRUE(contains(last_line(hr.output), "needs HR images")) << hr.output;
+  for (const char* row : {"hr", "mask-oracle"}) {
+    const CliRun needs_truth =
+        iesrgs("run " + scene + " -o " + out + " --input-is-lr --rows " + row + kTinySchedule);
+    EXPECT_EQ(needs_truth.status, 1) << row;
+    EXPECT_TRUE(contains(last_line(needs_truth.output), "need HR images")) << needs_truth.output;
+  }
 }
 
 // Rows that start from the internal model train a copy: the internal-only row, evaluated after

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <vector>
+
 namespace iesrgs::eval {
 namespace {
 
@@ -26,6 +28,8 @@ TEST(MaskAgreement, MaskFindsTheWrongExternalPixelsWhenTheInternalImageIsRight) 
   EXPECT_DOUBLE_EQ(counts.mask_share(), 2.0 / 16);
   EXPECT_EQ(counts.fused_error, 0);  // the mask swaps exactly the wrong pixels for right ones
   EXPECT_NEAR(counts.external_error, 2 * 3 * 0.45 * 0.45, 1e-5);
+  EXPECT_DOUBLE_EQ(counts.oracle_mask_share(), 2.0 / 16);
+  EXPECT_EQ(counts.oracle_error, 0);
 }
 
 TEST(MaskAgreement, MaskPicksTheWrongInternalPixels) {
@@ -40,6 +44,28 @@ TEST(MaskAgreement, MaskPicksTheWrongInternalPixels) {
   // The fused reference takes the one wrong pixel: 3 of 48 values off by 0.4, MSE 0.01.
   EXPECT_NEAR(counts.fused_psnr(), 20, 1e-4);
   EXPECT_EQ(counts.external_error, 0);
+  EXPECT_EQ(counts.closer, 0);
+  EXPECT_EQ(counts.oracle_error, 0);
+}
+
+// Each reference is right at some pixels and wrong at others; where both are equally close the
+// external image stays.
+TEST(MaskAgreement, OracleMaskTakesTheCloserReferencePerPixel) {
+  const torch::Tensor truth = image_with({}, 0);
+  torch::Tensor internal = image_with({1, 2}, 0.9f);            // wrong at 1 and 2
+  torch::Tensor external = image_with({7, 8}, 0.2f);            // wrong at 7 and 8
+  internal.index_put_({torch::indexing::Slice(), 2, 0}, 0.3f);  // pixel 8: off by 0.2, not 0.3
+  external.index_put_({torch::indexing::Slice(), 0, 2}, 0.9f);  // pixel 2: a tie
+  const torch::Tensor mask = oracle_mask(internal, external, truth);
+  EXPECT_EQ(mask.sizes(), torch::IntArrayRef({4, 4}));
+  const torch::Tensor picked = mask.nonzero().flatten().contiguous();  // (row, column) pairs
+  EXPECT_EQ(
+      std::vector<int64_t>(picked.data_ptr<int64_t>(), picked.data_ptr<int64_t>() + picked.numel()),
+      std::vector<int64_t>({1, 3, 2, 0}));
+  const MaskCounts counts = mask_counts(internal, external, truth, 0.6);
+  EXPECT_EQ(counts.closer, 2);
+  // Pixel 2 keeps the external image's 0.4 error, pixel 8 takes the internal image's 0.2.
+  EXPECT_NEAR(counts.oracle_error, 3 * (0.4 * 0.4 + 0.2 * 0.2), 1e-5);
 }
 
 TEST(MaskAgreement, PsnrAveragesOverTheImagesOwnChannels) {
