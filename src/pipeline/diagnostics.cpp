@@ -5,6 +5,7 @@
 
 #include <array>
 
+#include "eval/mask_agreement.hpp"
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
@@ -17,11 +18,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::array<const char*, 7> kColumns = {"external", "internal", "discrepancy", "mask",
-                                                 "render",   "depth",    "truth"};
+constexpr std::array<const char*, 8> kColumns = {"external",   "internal", "discrepancy", "mask",
+                                                 "mask_check", "render",   "depth",       "truth"};
 
 torch::Tensor gray_to_rgb(const torch::Tensor& map) {
   return map.clamp(0, 1).expand({3, -1, -1});
+}
+
+// M against the oracle mask: green where M hands the pixel to the internal image and that is the
+// closer reference to the truth, red where it is not, gray where M keeps the external image but
+// the internal one is closer.
+torch::Tensor mask_check(const torch::Tensor& mask, const torch::Tensor& oracle) {
+  const torch::Tensor right = (mask & oracle).to(torch::kFloat);
+  const torch::Tensor wrong = (mask & ~oracle).to(torch::kFloat);
+  const torch::Tensor missed = 0.35 * (~mask & oracle).to(torch::kFloat);
+  return torch::stack({wrong + missed, right + missed, missed});
 }
 
 torch::Tensor preview_tensor(const torch::Tensor& depth) {
@@ -37,11 +48,14 @@ std::array<torch::Tensor, kColumns.size()> columns(const DiagnosticView& v, doub
   if (v.external_image.defined() && v.internal_image.defined()) {
     const torch::Tensor d = loss::discrepancy(v.internal_image, v.external_image);
     out[2] = gray_to_rgb(d / (2 * threshold));
-    out[3] = gray_to_rgb((d >= threshold).to(torch::kFloat));
+    const torch::Tensor mask = d >= threshold;
+    out[3] = gray_to_rgb(mask.to(torch::kFloat));
+    if (v.truth.defined())
+      out[4] = mask_check(mask, eval::oracle_mask(v.internal_image, v.external_image, v.truth));
   }
-  out[4] = v.render;
-  out[5] = preview_tensor(v.render_depth);
-  out[6] = v.truth;
+  out[5] = v.render;
+  out[6] = preview_tensor(v.render_depth);
+  out[7] = v.truth;
   return out;
 }
 

@@ -52,7 +52,7 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
         "internal/point_cloud.ply", "internal/sr/rgb/r_0.png", "internal/sr/depth/r_0.npy",
         "rows/ie-srgs/point_cloud.ply", "rows/ie-srgs/test/metrics.json",
         "diagnostics/contact_sheet.png", "diagnostics/contact_sheet.html",
-        "diagnostics/r_0/mask.png", "diagnostics/r_0/truth.png"})
+        "diagnostics/r_0/mask.png", "diagnostics/r_0/mask_check.png", "diagnostics/r_0/truth.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "run" / file)) << file;
   const auto agreement =
       nlohmann::json::parse(read_file(dir / "run" / "diagnostics/mask_agreement.json"));
