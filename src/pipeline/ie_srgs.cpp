@@ -515,6 +515,11 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
       if (!row || std::find(rows_.begin(), rows_.end(), row->id) != rows_.end() ||
           !row_current(*row, internal_current))
         continue;
+      // The internal-only row scored the internal model of its own run, which this run may have
+      // trained again under other settings; the model's recorded training time names it.
+      if (row->source == Source::Internal &&
+          entry.value("train_seconds", -1.0) != stage_seconds(o_.output / "internal"))
+        continue;
       result.rows.push_back(earlier_row(*row, row_label(*row), entry));
       if (!same_lpips) result.rows.back().mean.lpips.reset();
     } catch (const nlohmann::json::exception&) {

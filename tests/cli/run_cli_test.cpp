@@ -190,6 +190,22 @@ TEST(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
   EXPECT_EQ(internal_psnr(), alone);
 }
 
+// A run that trains the internal model again under other settings drops the internal-only row
+// that scored the old one.
+TEST(RunCli, RetrainedInternalModelDropsTheEarlierInternalRow) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 1 --seed 3").status, 0);
+  const std::string rows = "run " + scene + " -o " + out + " --rows ";
+  ASSERT_EQ(iesrgs(rows + "internal,external" + kTinySchedule).status, 0);
+  const CliRun retrained = iesrgs(rows + "joint --internal-set seed=7" + kTinySchedule);
+  ASSERT_EQ(retrained.status, 0) << retrained.output;
+  const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+  std::vector<std::string> ids;
+  for (const auto& row : results["rows"]) ids.push_back(row["row"]);
+  EXPECT_EQ(ids, (std::vector<std::string>{"external", "joint"}));
+}
+
 // Earlier rows scored against test views that changed since leave the table, the internal-only
 // row too, though its model learnt from the unchanged training views.
 TEST(RunCli, RowsScoredAgainstOtherTestViewsLeaveTheTable) {
