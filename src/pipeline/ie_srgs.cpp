@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -47,6 +48,10 @@ struct RowSpec {
   // The mask from the HR truth instead of D: the internal image wherever it is the closer
   // reference. What IE-SRGS would reach with a perfect mask; benchmarks only.
   bool oracle_mask;
+
+  static bool needs_truth(const RowSpec& row) {
+    return row.source == Source::HighRes || row.oracle_mask;
+  }
 };
 
 constexpr RowSpec kRows[] = {
@@ -125,8 +130,8 @@ class Pipeline {
   RunResult run();
 
  private:
+  bool any_row(const std::function<bool(const RowSpec&)>& test) const;
   bool any_row(Source source) const;
-  bool any_oracle_row() const;
   bool row_uses_internal(const RowSpec& row) const;
   bool rows_use_internal_references() const;
   void check_cached_inputs() const;
@@ -141,7 +146,8 @@ class Pipeline {
   gs::GaussianModel initial_hr_model() const;
   RowResult evaluate_row(const RowSpec& row, const gs::GaussianModel& model, const fs::path& dir);
   RowResult run_fusion_row(const RowSpec& row);
-  bool row_current(const RowSpec& row, bool internal_current) const;
+  // Whether the earlier table's `entry` for `row` is what these settings would give.
+  bool row_current(const RowSpec& row, const nlohmann::json& entry, bool internal_current) const;
   void keep_earlier_rows(RunResult& result) const;
   void write_fusion_diagnostics(const gs::GaussianModel& model, const FusionSetup& setup) const;
   void write_mask_agreement(const FusionSetup& setup) const;
@@ -181,7 +187,7 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
   threshold_ = o_.threshold >= 0     ? o_.threshold
                : lr_scene_.synthetic ? loss::kDiscrepancyThresholdSynthetic
                                      : loss::kDiscrepancyThresholdReal;
-  if (o_.input_is_lr && (any_row(Source::HighRes) || any_oracle_row()))
+  if (o_.input_is_lr && any_row(RowSpec::needs_truth))
     fail(
         "the hr and mask-oracle rows need HR images, which a low-resolution input "
         "(--input-is-lr) lacks");
@@ -189,16 +195,14 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
   test_digest_ = split_digest(hr_images_ ? *hr_images_ : *lr_images_, Split::Test);
 }
 
-bool Pipeline::any_row(Source source) const {
+bool Pipeline::any_row(const std::function<bool(const RowSpec&)>& test) const {
   for (const std::string& id : rows_)
-    if (row_spec(id).source == source) return true;
+    if (test(row_spec(id))) return true;
   return false;
 }
 
-bool Pipeline::any_oracle_row() const {
-  for (const std::string& id : rows_)
-    if (row_spec(id).oracle_mask) return true;
-  return false;
+bool Pipeline::any_row(Source source) const {
+  return any_row([source](const RowSpec& row) { return row.source == source; });
 }
 
 bool Pipeline::row_uses_internal(const RowSpec& row) const {
@@ -484,11 +488,15 @@ RunResult Pipeline::run() {
   return result;
 }
 
-bool Pipeline::row_current(const RowSpec& row, bool internal_current) const {
+bool Pipeline::row_current(const RowSpec& row, const nlohmann::json& entry,
+                           bool internal_current) const {
   if (row.source == Source::HighRes && !hr_images_) return false;
   if (row_uses_internal(row) && !internal_current) return false;
-  return row.source == Source::Internal ||
-         training_stage_current(o_.output / "rows" / row.id, row_params(row, row_weights(row)),
+  // The internal-only row scored the internal model of its own run, which a later run may have
+  // trained again under other settings; the model's recorded training time names it.
+  if (row.source == Source::Internal)
+    return entry.value("train_seconds", -1.0) == stage_seconds(o_.output / "internal");
+  return training_stage_current(o_.output / "rows" / row.id, row_params(row, row_weights(row)),
                                 o_.fusion_config);
 }
 
@@ -513,12 +521,7 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
     try {
       const RowSpec* row = find_row(entry.at("row").get<std::string>());
       if (!row || std::find(rows_.begin(), rows_.end(), row->id) != rows_.end() ||
-          !row_current(*row, internal_current))
-        continue;
-      // The internal-only row scored the internal model of its own run, which this run may have
-      // trained again under other settings; the model's recorded training time names it.
-      if (row->source == Source::Internal &&
-          entry.value("train_seconds", -1.0) != stage_seconds(o_.output / "internal"))
+          !row_current(*row, entry, internal_current))
         continue;
       result.rows.push_back(earlier_row(*row, row_label(*row), entry));
       if (!same_lpips) result.rows.back().mean.lpips.reset();
