@@ -2,12 +2,15 @@
 
 #include <torch/serialize.h>
 
+#include <sstream>
 #include <string>
 
+#include "core/byte_reader.hpp"
 #include "core/error.hpp"
 #include "core/torch_error.hpp"
 #include "gs/sh.hpp"
 #include "io/atomic_file.hpp"
+#include "io/zip_archive.hpp"
 
 namespace iesrgs::gs {
 
@@ -64,15 +67,26 @@ void save_training_state(const std::filesystem::path& path, const GaussianModel&
   optimizer.save_state(archive);
   stats.save(archive);
   for (const auto& [name, value] : extras) archive.write("extra/" + name, value);
-  write_atomically(path, [&](const std::filesystem::path& tmp) { archive.save_to(tmp.string()); });
+  // Serialized in memory first: LibTorch's file writer throws from its destructor when the disk
+  // fills, which ends the process; the checked write below reports it and leaves no file.
+  std::ostringstream bytes;
+  archive.save_to(bytes);
+  write_file_atomically(path, bytes.str());
 }
 
 void load_training_state(const std::filesystem::path& path, GaussianModel& model,
                          GaussianOptimizer& optimizer, DensifyStats& stats,
                          CheckpointExtras* extras) {
+  const std::string bytes = read_file(path);
+  try {
+    // LibTorch's reader skips the CRCs, so damaged bytes would load as a different model.
+    ZipArchive(bytes).check_all();
+  } catch (const FormatError& e) {
+    fail_file(path, std::string("not a readable training checkpoint (") + e.what() + ")");
+  }
   try {
     torch::serialize::InputArchive archive;
-    archive.load_from(path.string(), torch::kCPU);  // wherever it was trained
+    archive.load_from(bytes.data(), bytes.size(), torch::kCPU);  // wherever it was trained
     GaussianModel loaded_model = load_model(archive);
     GaussianOptimizer loaded_optimizer = optimizer;
     loaded_optimizer.load_state(archive, loaded_model);

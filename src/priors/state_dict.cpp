@@ -9,8 +9,8 @@
 #include "core/byte_reader.hpp"
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/zip_archive.hpp"
 #include "priors/pickle.hpp"
-#include "priors/zip_archive.hpp"
 
 namespace iesrgs::priors {
 

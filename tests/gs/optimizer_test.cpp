@@ -8,6 +8,7 @@
 #include "gs/checkpoint.hpp"
 #include "gs/densify.hpp"
 #include "gs/random_model.hpp"
+#include "io/atomic_file.hpp"
 #include "raster/raster_test_scene.hpp"
 #include "support/cuda_device.hpp"
 #include "support/expect_error.hpp"
@@ -168,6 +169,30 @@ TEST(GaussianOptimizer, CorruptCheckpointNamesTheFile) {
   EXPECT_NE(message.find("bad.pt: not a readable training checkpoint"), std::string::npos);
   EXPECT_EQ(message.find('\n'), std::string::npos);
   EXPECT_EQ(m.size(), 2);
+}
+
+// LibTorch's reader does not check the CRCs: a damaged tensor must not load as a model.
+TEST(GaussianOptimizer, DamagedCheckpointIsRefused) {
+  testing::TempDir dir;
+  GaussianModel m = random_model(4);
+  m.means.data().fill_(1234.5f);
+  GaussianOptimizer opt(m, {}, 1);
+  save_training_state(dir / "state.pt", m, opt, DensifyStats::zeros(4));
+  std::string bytes = read_file(dir / "state.pt");
+  const float marker = 1234.5f;
+  const size_t at = bytes.find(std::string(reinterpret_cast<const char*>(&marker), 4));
+  ASSERT_NE(at, std::string::npos);
+  bytes[at] ^= 1;
+  testing::write_text(dir / "state.pt", bytes);
+
+  GaussianModel loaded = random_model(2);
+  GaussianOptimizer loaded_opt(loaded, {}, 1);
+  DensifyStats stats = DensifyStats::zeros(2);
+  const std::string message = testing::error_message(
+      [&] { load_training_state(dir / "state.pt", loaded, loaded_opt, stats); });
+  EXPECT_NE(message.find("state.pt: not a readable training checkpoint"), std::string::npos);
+  EXPECT_NE(message.find("fails its CRC"), std::string::npos) << message;
+  EXPECT_EQ(loaded.size(), 2);
 }
 
 // The pieces fit: one Adam step through the real rasterizer lowers an L1 loss.

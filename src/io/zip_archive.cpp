@@ -1,4 +1,4 @@
-#include "priors/zip_archive.hpp"
+#include "io/zip_archive.hpp"
 
 #include <fmt/format.h>
 #include <zlib.h>
@@ -8,7 +8,7 @@
 
 #include "core/byte_reader.hpp"
 
-namespace iesrgs::priors {
+namespace iesrgs {
 
 namespace {
 
@@ -56,6 +56,15 @@ std::string inflate_raw(std::string_view compressed, uint64_t size) {
   return out;
 }
 
+// The contents of member `name` must have the size and the CRC its directory entry gives.
+void check_contents(const std::string& name, uint64_t size, uint32_t crc,
+                    std::string_view contents) {
+  if (contents.size() != size)
+    throw FormatError(fmt::format("zip member '{}' has the wrong size", name));
+  if (crc32_z(0, reinterpret_cast<const Bytef*>(contents.data()), contents.size()) != crc)
+    throw FormatError(fmt::format("zip member '{}' fails its CRC", name));
+}
+
 }  // namespace
 
 ZipArchive::ZipArchive(std::string_view bytes) : bytes_(bytes) {
@@ -74,19 +83,24 @@ std::string ZipArchive::read(const std::string& name) const {
   const auto found = members_.find(name);
   if (found == members_.end()) throw FormatError(fmt::format("zip member '{}' is missing", name));
   const Member& member = found->second;
-  const std::string_view data = member_data(member);
-  std::string contents;
-  if (member.method == kStored && member.size == data.size()) {
-    contents = std::string(data);
-  } else if (member.method == kDeflated) {
-    contents = inflate_raw(data, member.size);
-  } else {
+  std::string contents =
+      member.method == kStored ? std::string(member_data(member)) : inflated(name, member);
+  check_contents(name, member.size, member.crc, contents);
+  return contents;
+}
+
+void ZipArchive::check_all() const {
+  // Stored members are checked in place: a checkpoint holds hundreds of megabytes of them.
+  for (const auto& [name, member] : members_)
+    check_contents(name, member.size, member.crc,
+                   member.method == kStored ? member_data(member) : inflated(name, member));
+}
+
+std::string ZipArchive::inflated(const std::string& name, const Member& member) const {
+  if (member.method != kDeflated)
     throw FormatError(
         fmt::format("zip member '{}' uses unsupported compression {}", name, member.method));
-  }
-  const uLong crc = crc32_z(0, reinterpret_cast<const Bytef*>(contents.data()), contents.size());
-  if (crc != member.crc) throw FormatError(fmt::format("zip member '{}' fails its CRC", name));
-  return contents;
+  return inflate_raw(member_data(member), member.size);
 }
 
 ZipArchive::Directory ZipArchive::find_directory() const {
@@ -167,4 +181,4 @@ std::string_view ZipArchive::member_data(const Member& member) const {
   return reader.take(member.compressed_size);
 }
 
-}  // namespace iesrgs::priors
+}  // namespace iesrgs

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-namespace iesrgs::priors {
+namespace iesrgs {
 
 class ZipArchive {
  public:
@@ -18,6 +18,9 @@ class ZipArchive {
   bool contains(const std::string& name) const { return members_.count(name) != 0; }
   // The uncompressed contents of member `name`. Throws FormatError.
   std::string read(const std::string& name) const;
+  // Checks every member against its CRC (a readable archive whose bytes were damaged later).
+  // Throws FormatError naming the first member that fails.
+  void check_all() const;
 
  private:
   struct Member {
@@ -37,9 +40,10 @@ class ZipArchive {
   Directory zip64_directory(size_t end_record) const;
   size_t read_member(size_t position);
   std::string_view member_data(const Member& member) const;
+  std::string inflated(const std::string& name, const Member& member) const;
 
   std::string_view bytes_;
   std::map<std::string, Member> members_;
 };
 
-}  // namespace iesrgs::priors
+}  // namespace iesrgs
