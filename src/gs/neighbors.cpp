@@ -18,22 +18,30 @@ struct PointGrid {
 
   std::array<int, 3> cell_of(const float* p) const {
     std::array<int, 3> c;
-    for (int a = 0; a < 3; ++a) c[a] = std::clamp(int((p[a] - origin[a]) / cell), 0, dims[a] - 1);
+    // Clamped as floats: an outlier's cell number need not fit an int.
+    for (int a = 0; a < 3; ++a)
+      c[a] = int(std::clamp((p[a] - origin[a]) / cell, 0.f, float(dims[a] - 1)));
     return c;
   }
   int index(int x, int y, int z) const { return (z * dims[1] + y) * dims[0] + x; }
 };
 
-// About one point per cell for a cloud filling its box; flatter clouds get more per cell.
+// The grid covers the central 98 % of the points along each axis; the others fall into its
+// border cells. Sized to the whole box, one far outlier (SfM clouds have them) would crowd every
+// other point into a few cells and make the search quadratic. About one point per cell for a
+// cloud filling its box; flatter clouds get more per cell.
 PointGrid build_grid(const float* points, int count) {
   PointGrid grid;
   std::array<float, 3> hi;
-  for (int a = 0; a < 3; ++a) grid.origin[a] = hi[a] = points[a];
-  for (int i = 0; i < count; ++i)
-    for (int a = 0; a < 3; ++a) {
-      grid.origin[a] = std::min(grid.origin[a], points[3 * i + a]);
-      hi[a] = std::max(hi[a], points[3 * i + a]);
-    }
+  std::vector<float> axis(count);
+  const int low_rank = count / 100, high_rank = count - 1 - count / 100;
+  for (int a = 0; a < 3; ++a) {
+    for (int i = 0; i < count; ++i) axis[i] = points[3 * i + a];
+    std::nth_element(axis.begin(), axis.begin() + low_rank, axis.end());
+    grid.origin[a] = axis[low_rank];
+    std::nth_element(axis.begin() + low_rank, axis.begin() + high_rank, axis.end());
+    hi[a] = axis[high_rank];
+  }
   const float span = std::max({hi[0] - grid.origin[0], hi[1] - grid.origin[1],
                                hi[2] - grid.origin[2], std::numeric_limits<float>::min()});
   grid.cell = span / std::max(1.f, std::cbrt(float(count)));

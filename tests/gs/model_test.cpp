@@ -38,15 +38,18 @@ std::vector<float> brute_force_knn(const std::vector<float>& p, int k) {
 TEST(GaussianModel, GridNearestNeighboursMatchBruteForce) {
   std::mt19937 rng(3);
   std::normal_distribution<float> normal(0.f, 1.f);
-  std::vector<float> clustered, flat;
+  std::vector<float> clustered, flat, far_outliers;
   for (int i = 0; i < 1500; ++i) {
-    // Clusters of very different density, and a flat sheet (one empty axis).
+    // Clusters of very different density, a flat sheet (one empty axis), and a cloud with 3 % of
+    // its points up to 1e6 times further out, beyond the grid, as SfM clouds have them.
     const float spread = i % 3 == 0 ? 0.01f : 2.f;
     for (int a = 0; a < 3; ++a)
       clustered.push_back(normal(rng) * spread + (i % 3 == 0 ? 5.f : 0.f));
     flat.insert(flat.end(), {normal(rng), normal(rng), 0.f});
+    const float reach = i % 33 == 0 ? std::pow(10.f, float(i % 7)) : 1.f;
+    for (int a = 0; a < 3; ++a) far_outliers.push_back(normal(rng) * reach);
   }
-  for (const auto* points : {&clustered, &flat}) {
+  for (const auto* points : {&clustered, &flat, &far_outliers}) {
     const std::vector<float> fast = mean_knn_squared_distance(points->data(), 1500);
     const std::vector<float> slow = brute_force_knn(*points, 3);
     for (size_t i = 0; i < fast.size(); ++i) ASSERT_NEAR(fast[i], slow[i], 1e-6f * slow[i]) << i;
