@@ -16,6 +16,11 @@ int main(int argc, char** argv) {
   // uses for our own kernels (OMP_NUM_THREADS still limits both).
   torch::set_num_threads(omp_get_max_threads());
   app.require_subcommand(1);
+  // Option errors in the form of every other error (CLI11's exit codes stay); set before the
+  // subcommands are added, which copy it.
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return fmt::format("error: {} (--help lists the options)\n", e.what());
+  });
   // Which device --device auto takes here, so a user sees at once whether the GPU is usable.
   app.set_version_flag("--version", [] {
     return fmt::format("iesrgs 0.1.0\nCUDA kernels: {}\n--device auto: {}",
@@ -45,6 +50,10 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const iesrgs::Interrupted& e) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "interrupted: %s\n", e.what());
+    return 130;
   } catch (...) {
     return report(iesrgs::current_exception_message().c_str());
   }

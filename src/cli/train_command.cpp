@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/memory.hpp"
 #include "io/atomic_file.hpp"
+#include "io/json_file.hpp"
 #include "train/session.hpp"
 
 namespace iesrgs::cli {
@@ -31,12 +32,6 @@ struct TrainArgs {
   bool resume = false;
   std::string device = "auto";
 };
-
-nlohmann::json read_json_file(const std::filesystem::path& path) {
-  nlohmann::json json = nlohmann::json::parse(read_file(path), nullptr, false);
-  if (json.is_discarded()) fail_file(path, "is not valid JSON");
-  return json;
-}
 
 train::TrainConfig resolve_config(const TrainArgs& args, const std::filesystem::path& saved) {
   train::TrainConfig config;
@@ -73,8 +68,6 @@ void run_train(const TrainArgs& args) {
   use_device(args.device);
   const std::filesystem::path out = args.output;
   const train::TrainConfig config = resolve_config(args, out / "config.json");
-  if (!args.resume)
-    write_file_atomically(out / "config.json", train::to_json(config).dump(2) + "\n");
 
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   ViewImages images(scene);
@@ -83,17 +76,18 @@ void run_train(const TrainArgs& args) {
   const int height = setup.train_views.front().camera.intrinsics.height;
   fmt::print("training on {} views ({}x{}), {} test views; preset {}, {} iterations, K = {}\n",
              setup.train_views.size(), width, height, setup.test_views.size(), config.preset,
-             config.iterations, config.views_per_iteration);
+             config.iterations, setup.views_per_step(config));
 
   train::Trainer trainer = args.resume
                                ? train::Trainer::resumed(config, std::move(setup))
                                : train::Trainer(config, std::move(setup),
                                                 train::initial_model(scene, config, args.init_ply));
+  // Only now that the scene and the starting model have loaded: a folder holding a config but no
+  // checkpoint would make --resume fail on that instead of the real problem.
+  if (!args.resume)
+    write_file_atomically(out / "config.json", train::to_json(config).dump(2) + "\n");
   const train::TrainSummary summary = trainer.run();
-  if (summary.interrupted) {
-    fmt::print("continue with the same command and --resume\n");
-    return;
-  }
+  if (summary.interrupted) throw Interrupted("continue with the same command and --resume");
   train::write_point_clouds(out, trainer.model());
 
   const nlohmann::json report = {{"scene", scene.root.string()},

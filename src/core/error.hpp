@@ -14,6 +14,13 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Training stopped by Ctrl-C after saving its checkpoint: the CLI says so and exits with 130, the
+// shell's status for SIGINT, so scripts see that the run did not finish.
+class Interrupted : public Error {
+ public:
+  using Error::Error;
+};
+
 // Throws Error("<path>: <problem>").
 [[noreturn]] void fail_file(const std::filesystem::path& path, const std::string& problem);
 

@@ -39,7 +39,7 @@ class BinaryReader {
     const uint64_t bits = read<uint64_t>(what);
     double value;
     std::memcpy(&value, &bits, sizeof value);
-    if (!std::isfinite(value)) fail(fmt::format("{} is not finite", what));
+    if (const std::string problem = number_problem(value, what); !problem.empty()) fail(problem);
     return value;
   }
 

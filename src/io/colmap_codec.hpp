@@ -1,8 +1,10 @@
 #pragma once
 // Internal to the COLMAP model reader and writer: COLMAP's camera model table and one decoder /
 // encoder per file and encoding. `source` / `target` only name the file in error messages.
+#include <cmath>
 #include <cstddef>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <string>
 #include <string_view>
@@ -37,6 +39,15 @@ const char* image_name_problem(std::string_view name);
 // The name of an image about to be written; throws Error naming `target` when it is not valid.
 const std::string& writable_image_name(const ColmapImage& image,
                                        const std::filesystem::path& target);
+
+// Why a decoded number cannot be used, or an empty string. NaN and infinities are refused, and so
+// is a value beyond the float range, since positions and intrinsics are used in single precision.
+inline std::string number_problem(double value, const char* what) {
+  if (!std::isfinite(value)) return fmt::format("{} is not finite", what);
+  if (std::abs(value) > std::numeric_limits<float>::max())
+    return fmt::format("{} {} is beyond the single-precision range", what, value);
+  return {};
+}
 
 // Adds `record` under its id; `in` reports a repeated id (ids are unique within a file).
 template <typename Record, typename Reader>

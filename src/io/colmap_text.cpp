@@ -74,7 +74,7 @@ class TextReader {
     if (ec != std::errc() || end != token.data() + token.size())
       fail(fmt::format("{} '{}' is not a valid number", what, printable(token)));
     if constexpr (std::is_floating_point_v<T>)
-      if (!std::isfinite(value)) fail(fmt::format("{} is not finite", what));
+      if (const std::string problem = number_problem(value, what); !problem.empty()) fail(problem);
     return value;
   }
 

@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <utility>
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/json_file.hpp"
 
 namespace iesrgs {
 
@@ -37,18 +39,7 @@ std::string quoted(const json& value) {
 }
 
 json parse_object(const std::string& text, const fs::path& json_path) {
-  json document;
-  try {
-    document = json::parse(text);
-  } catch (const json::parse_error& e) {
-    // what() starts with an id such as "[json.exception.parse_error.101] ": keep what follows.
-    const std::string detail = e.what();
-    const size_t id_end = detail.find("] ");
-    fail_file(json_path, fmt::format("malformed JSON at byte {} ({})", e.byte,
-                                     detail.substr(id_end == std::string::npos ? 0 : id_end + 2)));
-  } catch (const json::exception& e) {  // e.g. a number too large for a double
-    fail_file(json_path, fmt::format("invalid JSON ({})", e.what()));
-  }
+  json document = parse_json(text, json_path);
   if (!document.is_object()) fail_file(json_path, "top level is not a JSON object");
   return document;
 }
@@ -139,8 +130,10 @@ void read_pose(const json& frame, const Where& where, Camera& camera) {
     where.fail("\"transform_matrix\" must be a 4x4 array of numbers");
   if (!is_rotation(c2w)) where.fail("\"transform_matrix\" does not hold a rotation");
   opengl_c2w_to_opencv_w2c(c2w, camera.rotation, camera.translation);
+  // Used in single precision downstream, like every position.
+  const auto in_range = [](double v) { return std::abs(v) <= std::numeric_limits<float>::max(); };
   const Vec3& t = camera.translation;
-  if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z))
+  if (!in_range(t.x) || !in_range(t.y) || !in_range(t.z))
     where.fail("\"transform_matrix\" position is out of range");
 }
 

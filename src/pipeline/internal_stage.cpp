@@ -46,7 +46,7 @@ InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train
   const train::TrainConfig& c = config;
   fmt::print("internal model: {} LR views ({}x{}), K = {}, {} iterations\n",
              setup.train_views.size(), setup.train_views.front().camera.intrinsics.width,
-             setup.train_views.front().camera.intrinsics.height, c.views_per_iteration,
+             setup.train_views.front().camera.intrinsics.height, setup.views_per_step(c),
              c.iterations);
   std::vector<Camera> cameras;
   for (const train::TrainView& view : setup.train_views) cameras.push_back(view.camera);

@@ -69,8 +69,9 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
                                      : train::Trainer(config, std::move(setup), initial_model());
   const train::TrainSummary summary = trainer.run();
   if (summary.interrupted)
-    fail("{} interrupted at iteration {}; run the same command again to resume", name,
-         summary.iterations);
+    throw Interrupted(
+        fmt::format("{} stopped at iteration {}; run the same command again to resume", name,
+                    summary.iterations));
   train::write_point_clouds(dir, trainer.model());
   record_stage(dir, identity, true, summary.seconds);
   fmt::print("{}: {} Gaussians after {} ({:.2f} it/s)\n", name, summary.gaussians,

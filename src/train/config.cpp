@@ -147,15 +147,17 @@ void validate(const TrainConfig& c) {
   require(c.views_per_iteration >= 1, "views_per_iteration must be at least 1");
   require(c.dssim_weight >= 0 && c.dssim_weight <= 1, "dssim_weight must be in [0, 1]");
   require(c.max_sh_degree >= 0 && c.max_sh_degree <= 3, "max_sh_degree must be 0..3");
-  require(c.sh_increase_every > 0 && c.densify_every > 0 && c.opacity_reset_every > 0 &&
-              c.filter_update_every > 0 && c.log_every > 0,
-          "intervals must be positive");
+  require(c.sh_increase_every > 0, "sh_increase_every must be positive");
+  require(c.densify_every > 0, "densify_every must be positive");
+  require(c.opacity_reset_every > 0, "opacity_reset_every must be positive");
+  require(c.filter_update_every > 0, "filter_update_every must be positive");
+  require(c.log_every > 0, "log_every must be positive");
   require(c.checkpoint_every >= 0 && c.test_every >= 0 && c.test_views >= 0,
           "checkpoint_every, test_every and test_views must not be negative");
   require(c.grad_threshold > 0, "grad_threshold must be positive");
   require(c.max_gaussians >= 0, "max_gaussians must be 0 (no cap) or positive");
   require(c.init == "auto" || c.init == "random", "init must be \"auto\" or \"random\"");
-  require(c.random_points > 0, "random init needs points");
+  require(c.random_points > 0, "random_points must be positive");
   require(c.random_extent >= 0, "random_extent must be 0 (from the scene) or positive");
   require(c.learning_rates.position_max_steps > 0, "lr_position_max_steps must be positive");
 }

@@ -193,7 +193,7 @@ void Trainer::require_same_cameras() const {
 std::vector<int> Trainer::pick_views() {
   std::vector<int> order(setup_.train_views.size());
   std::iota(order.begin(), order.end(), 0);
-  const size_t count = std::min(order.size(), size_t(config_.views_per_iteration));
+  const size_t count = setup_.views_per_step(config_);
   for (size_t i = 0; i < count; ++i) {  // partial Fisher-Yates: `count` distinct views
     std::uniform_int_distribution<size_t> pick(i, order.size() - 1);
     std::swap(order[i], order[pick(view_rng_)]);

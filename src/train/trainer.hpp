@@ -5,6 +5,7 @@
 // It trains on the compute device (core/device.hpp) that is current when it is built.
 #include <torch/types.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <filesystem>
@@ -37,6 +38,11 @@ struct TrainerSetup {
   double scene_extent = 1;
   std::filesystem::path output_dir;  // checkpoint.pt, train_log.csv, cameras.json go here
   ViewLoss loss;                     // empty: the photometric default
+
+  // K as an iteration applies it: distinct views, so at most every training view.
+  size_t views_per_step(const TrainConfig& config) const {
+    return std::min(train_views.size(), size_t(config.views_per_iteration));
+  }
 };
 
 // Fails up front when training `gaussians` Gaussians would not fit in the available memory of

@@ -417,6 +417,10 @@ TEST(Colmap, CorruptBinaryValuesAreRefused) {
   nan_param.replace(8 + 24, 8, Bytes().f64(std::nan("")).str());
   expect_error([&] { parse_colmap_cameras(nan_param, binary, "cameras.bin"); },
                {"cameras.bin", "camera parameter is not finite"});
+  std::string huge_param = tiny_cameras_bin();
+  huge_param.replace(8 + 24, 8, Bytes().f64(1e300).str());
+  expect_error([&] { parse_colmap_cameras(huge_param, binary, "cameras.bin"); },
+               {"cameras.bin", "camera parameter 1e+300 is beyond the single-precision range"});
   std::string unknown_model = tiny_cameras_bin();
   unknown_model.replace(12, 4, Bytes().i32(42).str());
   expect_error([&] { parse_colmap_cameras(unknown_model, binary, "cameras.bin"); },

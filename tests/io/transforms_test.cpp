@@ -314,6 +314,9 @@ TEST(NerfstudioScene, BadInputGivesOneLineErrorNamingFileAndProblem) {
              {c, -c, 0, 1.7e308}, {c, c, 0, 1.7e308}, {0, 0, 1, 0}, {0, 0, 0, 1}};
        }),
        {"frame 0: \"transform_matrix\" position is out of range"}},
+      {"position beyond float",
+       edited([](json& d) { d["frames"][0]["transform_matrix"][0][3] = 1e300; }),
+       {"frame 0: \"transform_matrix\" position is out of range"}},
       {"no focal",
        edited([](json& d) { d.erase("fl_x"); }),
        {"frame 0: missing \"fl_x\" (or \"camera_angle_x\")"}},
