@@ -1,6 +1,7 @@
 // iesrgs eval: PSNR / SSIM (and LPIPS when its weights are at hand) of rendered images against
 // their ground truth, per view and averaged, as JSON and CSV.
 #include <fmt/core.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 
@@ -58,6 +59,16 @@ class GroundTruth {
 
   const float* background() const { return background_.data(); }
 
+  // The scene views of the split that no render was scored against (none for a plain folder).
+  std::vector<std::string> unscored(const std::vector<eval::ViewMetrics>& scored) const {
+    std::vector<std::string> names;
+    for (const auto& [name, camera] : cameras_)
+      if (std::none_of(scored.begin(), scored.end(),
+                       [&](const eval::ViewMetrics& v) { return v.name == name; }))
+        names.push_back(name);
+    return names;
+  }
+
   Image get(const std::string& name) {
     if (scene_) {
       const auto found = cameras_.find(name);
@@ -108,6 +119,14 @@ void run_eval(const EvalArgs& args) {
                                          ? std::filesystem::path(args.renders) / "metrics"
                                          : std::filesystem::path(args.output);
   eval::write_report(base, report);
+  // A mean over part of a split is not the split's score: say so, next to the numbers.
+  const std::vector<std::string> unscored = truth.unscored(report.views);
+  if (!unscored.empty())
+    fmt::print(
+        "note: {} views of the {} split have no render and are not in the mean: {}{}\n",
+        unscored.size(), args.split,
+        fmt::join(unscored.begin(), unscored.begin() + std::min<size_t>(5, unscored.size()), ", "),
+        unscored.size() > 5 ? ", ..." : "");
   const eval::ViewMetrics mean = report.mean();
   fmt::print("{} views: PSNR {:.3f} dB, SSIM {:.4f}, LPIPS {}\nwrote {}.json and .csv\n",
              report.views.size(), mean.psnr, mean.ssim,

@@ -25,7 +25,10 @@ void run_export(const ExportArgs& args) {
   const std::string format = lowercase_extension(output);
   if (format != ".splat" && format != ".spz" && format != ".ply")
     fail_file(output, "unknown export format: the name must end in .splat, .spz or .ply");
-  const SplatCloud cloud = read_model(model_file(args.model));
+  const std::filesystem::path model = model_file(args.model);
+  const SplatCloud cloud = read_model(model);
+  // An empty .splat is an empty file, which no reader can tell from a damaged one.
+  if (cloud.size() == 0) fail_file(model, "holds no Gaussians: nothing to export");
   if (format == ".splat")
     write_splat(output, cloud);
   else if (format == ".spz")

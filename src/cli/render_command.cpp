@@ -3,6 +3,8 @@
 // camera path made from the training cameras (--path orbit | interp).
 #include <fmt/core.h>
 
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
@@ -51,12 +53,18 @@ void run_render(const RenderArgs& args) {
                                    : pipeline::interpolated_path(train, args.frames);
   }
   if (cameras.empty()) fail_file(scene.root, fmt::format("has no {} views", args.split));
+  // Checked before scaling, which rounds to int: a side beyond 2^16 is no render anyone can store.
+  const double width = cameras.front().intrinsics.width * args.scale,
+               height = cameras.front().intrinsics.height * args.scale;
+  if (std::min(width, height) < 0.5 || std::max(width, height) > 65536)
+    fail("--scale {}: the {} views would be {:.0f}x{:.0f} pixels (1 to 65536 a side)", args.scale,
+         what, width, height);
+  const Camera first = cameras.front().scaled(args.scale);
   const char* mode = model.antialiased ? "antialiased" : "classic";
   fmt::print("rendering {} {} views of {} Gaussians at x{} ({})\n", cameras.size(), what,
              model.size(), args.scale, mode);
   const double seconds =
       pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
-  const Camera first = cameras.front().scaled(args.scale);
   const nlohmann::json report = {{"views", cameras.size()},
                                  {"width", first.intrinsics.width},
                                  {"height", first.intrinsics.height},

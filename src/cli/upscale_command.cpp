@@ -55,11 +55,24 @@ std::vector<Job> folder_jobs(const fs::path& folder, const fs::path& out) {
   return jobs;
 }
 
-std::vector<Job> jobs_for(const fs::path& input, const fs::path& output) {
+std::vector<Job> named_jobs(const fs::path& input, const fs::path& output) {
   if (fs::is_directory(input)) return folder_jobs(input, output);
   if (!fs::exists(input)) fail_file(input, "no such image or folder");
   if (fs::is_directory(output)) return {{input, output / input.stem().concat(".png")}};
+  if (lowercase_extension(output) != ".png")
+    fail_file(output, "upscale writes PNG images: name the output .png, or give a folder");
   return {{input, output}};
+}
+
+// The jobs, none of which may write over its own input.
+std::vector<Job> jobs_for(const fs::path& input, const fs::path& output) {
+  std::vector<Job> jobs = named_jobs(input, output);
+  for (const Job& job : jobs) {
+    std::error_code ec;  // set, and false returned, when the output does not exist yet
+    if (fs::equivalent(job.input, job.output, ec))
+      fail_file(job.output, "is the input itself; write the upscaled images elsewhere");
+  }
+  return jobs;
 }
 
 // Decodes, composites any alpha over the background, upscales and writes one image.

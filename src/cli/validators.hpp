@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <string>
 
 namespace iesrgs::cli {
@@ -13,7 +14,8 @@ inline CLI::Validator number_above(double bound, bool inclusive, const std::stri
   return CLI::Validator(
       [=](std::string& text) -> std::string {
         double value = 0;
-        if (!CLI::detail::lexical_cast(text, value)) return "must be a number, got " + text;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value))
+          return "must be a number, got " + text;
         if (inclusive ? value >= bound : value > bound) return {};
         return fmt::format("must be {} {}, got {}", inclusive ? "at least" : "greater than", bound,
                            text);

@@ -134,6 +134,40 @@ TEST(Cli, UpscaleOfAMissingInputNamesIt) {
             "error: " + (dir / "nothing.png").string() + ": no such image or folder");
 }
 
+TEST(Cli, UpscaleNeverWritesOverItsInputNorPngBytesUnderAnotherName) {
+  TempDir dir;
+  const std::string image = (dir / "in" / "a.png").string();
+  write_png(image, Image8(6, 4, 3));
+  const std::string before = read_file(image);
+  for (const std::string& output : {image, (dir / "in").string()}) {
+    const CliRun run = iesrgs("upscale --model bicubic --scale 2 " + image + " " + output);
+    EXPECT_EQ(run.status, 1) << run.output;
+    EXPECT_EQ(last_line(run.output),
+              "error: " + image + ": is the input itself; write the upscaled images elsewhere");
+  }
+  const CliRun folder = iesrgs("upscale --model bicubic --scale 2 " + (dir / "in").string() + " " +
+                               (dir / "in").string());
+  EXPECT_EQ(folder.status, 1) << folder.output;
+  EXPECT_EQ(read_file(image), before);
+  const std::string jpeg = (dir / "a.jpg").string();
+  const CliRun named = iesrgs("upscale --model bicubic --scale 2 " + image + " " + jpeg);
+  EXPECT_EQ(named.status, 1) << named.output;
+  EXPECT_TRUE(contains(last_line(named.output), jpeg + ": upscale writes PNG images"))
+      << named.output;
+  EXPECT_FALSE(std::filesystem::exists(jpeg));
+}
+
+TEST(Cli, ExportOfAnEmptyModelWritesNothing) {
+  TempDir dir;
+  write_ply(dir / "empty.ply", SplatCloud());
+  const std::string output = (dir / "empty.splat").string();
+  const CliRun run = iesrgs("export " + (dir / "empty.ply").string() + " " + output);
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_EQ(last_line(run.output),
+            "error: " + (dir / "empty.ply").string() + ": holds no Gaussians: nothing to export");
+  EXPECT_FALSE(std::filesystem::exists(output));
+}
+
 TEST(Cli, InfoOfAModelSummarizesItsGaussians) {
   TempDir dir;
   SplatCloud cloud;
@@ -172,6 +206,19 @@ TEST(Cli, EvalCompositesRgbaRendersOverTheBackground) {
   const CliRun on_black = iesrgs("eval --lpips none --background black " + folders);
   EXPECT_EQ(on_black.status, 0) << on_black.output;
   EXPECT_TRUE(contains(on_black.output, "1 views: PSNR 0.000 dB")) << on_black.output;
+}
+
+TEST(Cli, EvalOfPartOfASplitNamesTheViewsLeftOut) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 2 --test-views 2").status, 0);
+  write_text(dir / "renders" / "r_0.png", read_file(dir / "scene" / "test" / "r_0.png"));
+  const CliRun run = iesrgs("eval --lpips none " + (dir / "renders").string() + " " + scene);
+  EXPECT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(contains(run.output,
+                       "1 views of the test split have no render and are not in the "
+                       "mean: r_1\n1 views: PSNR inf dB"))
+      << run.output;
 }
 
 }  // namespace

@@ -62,8 +62,10 @@ std::vector<torch::Tensor> blend_weights(const std::vector<Span>& spans, int64_t
 torch::Tensor upscale_tiled(SrNet& net, const torch::Tensor& rgb, const TileOptions& options) {
   check_rgb_batch(rgb, net.name());
   if (options.overlap < 0 || (options.tile > 0 && options.overlap >= options.tile))
-    fail("tiling: the overlap ({}) must be at least 0 and smaller than the tile ({})",
-         options.overlap, options.tile);
+    fail(
+        "tiled super-resolution: the overlap ({}, --tile-overlap) must be at least 0 and smaller "
+        "than the tile ({}, --tile)",
+        options.overlap, options.tile);
   const int64_t height = rgb.size(2), width = rgb.size(3), scale = net.scale();
   if (options.tile <= 0 || (height <= options.tile && width <= options.tile))
     return net.upscale(rgb);
