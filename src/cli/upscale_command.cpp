@@ -60,7 +60,8 @@ std::vector<Job> named_jobs(const fs::path& input, const fs::path& output) {
   if (!fs::exists(input)) fail_file(input, "no such image or folder");
   if (fs::is_directory(output)) return {{input, output / input.stem().concat(".png")}};
   if (lowercase_extension(output) != ".png")
-    fail_file(output, "upscale writes PNG images: name the output .png, or give a folder");
+    fail_file(output,
+              "upscale writes PNG images: name the output .png, or give an existing folder");
   return {{input, output}};
 }
 
