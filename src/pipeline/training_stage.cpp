@@ -52,9 +52,14 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   const fs::path dir = setup.output_dir;
   const nlohmann::json identity = stage_identity(params, config);
   if (model_finished(dir, identity)) {
-    fmt::print("{}: reusing the finished model in {}\n", name, dir.string());
-    return {gs::model_from_splat_cloud(read_cached_output(dir / "point_cloud.ply", read_ply)),
-            stage_seconds(dir), true};
+    try {
+      gs::GaussianModel model = gs::model_from_splat_cloud(read_ply(dir / "point_cloud.ply"));
+      fmt::print("{}: reusing the finished model in {}\n", name, dir.string());
+      return {std::move(model), stage_seconds(dir), true};
+    } catch (const Error& e) {
+      // Damaged since it was written: made again from the final checkpoint, or trained again.
+      fmt::print("{}: {}; writing it again\n", name, e.what());
+    }
   }
   const fs::path checkpoint = train::checkpoint_path(dir);
   const bool resumable =
