@@ -2,7 +2,6 @@
 
 #include <torch/serialize.h>
 
-#include <sstream>
 #include <string>
 
 #include "core/byte_reader.hpp"
@@ -69,9 +68,12 @@ void save_training_state(const std::filesystem::path& path, const GaussianModel&
   for (const auto& [name, value] : extras) archive.write("extra/" + name, value);
   // Serialized in memory first: LibTorch's file writer throws from its destructor when the disk
   // fills, which ends the process; the checked write below reports it and leaves no file.
-  std::ostringstream bytes;
-  archive.save_to(bytes);
-  write_file_atomically(path, bytes.str());
+  std::string bytes;
+  archive.save_to([&bytes](const void* data, size_t size) {
+    bytes.append(static_cast<const char*>(data), size);
+    return size;
+  });
+  write_file_atomically(path, bytes);
 }
 
 void load_training_state(const std::filesystem::path& path, GaussianModel& model,
@@ -81,10 +83,6 @@ void load_training_state(const std::filesystem::path& path, GaussianModel& model
   try {
     // LibTorch's reader skips the CRCs, so damaged bytes would load as a different model.
     ZipArchive(bytes).check_all();
-  } catch (const FormatError& e) {
-    fail_file(path, std::string("not a readable training checkpoint (") + e.what() + ")");
-  }
-  try {
     torch::serialize::InputArchive archive;
     archive.load_from(bytes.data(), bytes.size(), torch::kCPU);  // wherever it was trained
     GaussianModel loaded_model = load_model(archive);
@@ -98,6 +96,8 @@ void load_training_state(const std::filesystem::path& path, GaussianModel& model
     model = std::move(loaded_model);
     optimizer = std::move(loaded_optimizer);
     stats = std::move(loaded_stats);
+  } catch (const FormatError& e) {
+    fail_file(path, std::string("not a readable training checkpoint (") + e.what() + ")");
   } catch (const c10::Error& e) {
     fail_file(path, "not a readable training checkpoint (" + torch_error_line(e) + ")");
   } catch (const Error& e) {
