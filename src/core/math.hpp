@@ -2,6 +2,7 @@
 // Small fixed-size vector and matrix types for camera geometry (double precision on the host).
 #include <array>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace iesrgs {
@@ -29,6 +30,12 @@ struct Vec3 {
 template <typename T>
 T sign(T t) {
   return T((t > 0) - (t < 0));
+}
+
+// Whether a value read in double precision survives the float conversion that training applies to
+// positions and intrinsics: false for NaN, infinities and magnitudes beyond float's range.
+inline bool fits_float(double value) {
+  return std::abs(value) <= std::numeric_limits<float>::max();
 }
 
 inline double sigmoid(double x) {

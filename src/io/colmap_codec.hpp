@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
-#include <limits>
 #include <map>
 #include <string>
 #include <string_view>
@@ -13,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "core/math.hpp"
 #include "io/colmap.hpp"
 
 namespace iesrgs::colmap_codec {
@@ -44,7 +44,7 @@ const std::string& writable_image_name(const ColmapImage& image,
 // is a value beyond the float range, since positions and intrinsics are used in single precision.
 inline std::string number_problem(double value, const char* what) {
   if (!std::isfinite(value)) return fmt::format("{} is not finite", what);
-  if (std::abs(value) > std::numeric_limits<float>::max())
+  if (!fits_float(value))
     return fmt::format("{} {} is beyond the single-precision range", what, value);
   return {};
 }

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <optional>
 #include <utility>
 
@@ -130,10 +129,8 @@ void read_pose(const json& frame, const Where& where, Camera& camera) {
     where.fail("\"transform_matrix\" must be a 4x4 array of numbers");
   if (!is_rotation(c2w)) where.fail("\"transform_matrix\" does not hold a rotation");
   opengl_c2w_to_opencv_w2c(c2w, camera.rotation, camera.translation);
-  // Used in single precision downstream, like every position.
-  const auto in_range = [](double v) { return std::abs(v) <= std::numeric_limits<float>::max(); };
   const Vec3& t = camera.translation;
-  if (!in_range(t.x) || !in_range(t.y) || !in_range(t.z))
+  if (!fits_float(t.x) || !fits_float(t.y) || !fits_float(t.z))
     where.fail("\"transform_matrix\" position is out of range");
 }
 
