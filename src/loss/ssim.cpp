@@ -120,36 +120,51 @@ PaddedSpan padded_span(const ImageShape& shape, const PixelBox& box) {
   return {first, last - first, first - (box.col0 - kRadius)};
 }
 
+// What both passes over one box read: the row loops, the two images, and where the box lies.
+template <typename T>
+struct BoxInputs {
+  BoxInputs(const SsimRows<T>& rows, const T* x, const T* y, const ImageShape& shape,
+            const PixelBox& box)
+      : rows(rows),
+        x(x),
+        y(y),
+        shape(shape),
+        box(box),
+        width(box.col1 - box.col0),
+        span(padded_span(shape, box)) {}
+
+  SsimRows<T> rows;
+  const T* x;
+  const T* y;
+  ImageShape shape;
+  PixelBox box;
+  int width;
+  PaddedSpan span;
+};
+
 // The forward pass over the pixels of one box: map and partials there, nothing elsewhere.
 template <typename T>
 class ForwardBox {
  public:
-  ForwardBox(const SsimRows<T>& rows, const T* x, const T* y, const ImageShape& shape,
-             const PixelBox& box, T* map, T* partials)
-      : rows_(rows),
-        x_(x),
-        y_(y),
-        shape_(shape),
-        box_(box),
-        width_(box.col1 - box.col0),
-        span_(padded_span(shape, box)),
+  ForwardBox(const BoxInputs<T>& in, T* map, T* partials)
+      : in_(in),
         map_(map),
         partials_(partials),
-        ring_(kMomentPlanes, width_),
-        padded_x_(width_ + 2 * kRadius, T(0)),
+        ring_(kMomentPlanes, in.width),
+        padded_x_(in.width + 2 * kRadius, T(0)),
         padded_y_(padded_x_),
-        stats_(kMomentPlanes * width_),
-        points_((1 + kPartialPlanes) * width_) {}
+        stats_(kMomentPlanes * in.width),
+        points_((1 + kPartialPlanes) * in.width) {}
 
   // Sum of the per-channel SSIM over the box.
   double run() {
     if (map_)
-      for (int r = box_.row0; r < box_.row1; ++r)
-        std::fill_n(map_ + size_t(r) * shape_.width + box_.col0, width_, T(0));
+      for (int r = in_.box.row0; r < in_.box.row1; ++r)
+        std::fill_n(map_ + size_t(r) * in_.shape.width + in_.box.col0, in_.width, T(0));
     double sum = 0;
-    for (int c = 0; c < shape_.channels; ++c) {
+    for (int c = 0; c < in_.shape.channels; ++c) {
       sweep(
-          box_.row0, box_.row1, [&](int r) { row_pass(r, c); },
+          in_.box.row0, in_.box.row1, [&](int r) { row_pass(r, c); },
           [&](int r) { sum += column_pass(r, c); });
     }
     return sum;
@@ -161,42 +176,42 @@ class ForwardBox {
   }
 
   void row_pass(int r, int c) {
-    if (r < 0 || r >= shape_.height) {
+    if (r < 0 || r >= in_.shape.height) {
       ring_.clear(r);
       return;
     }
-    const size_t offset = row_offset(shape_, c, r) + span_.first;
-    std::copy_n(x_ + offset, span_.count, padded_x_.data() + span_.padded_offset);
-    std::copy_n(y_ + offset, span_.count, padded_y_.data() + span_.padded_offset);
+    const size_t offset = row_offset(in_.shape, c, r) + in_.span.first;
+    std::copy_n(in_.x + offset, in_.span.count, padded_x_.data() + in_.span.padded_offset);
+    std::copy_n(in_.y + offset, in_.span.count, padded_y_.data() + in_.span.padded_offset);
     const T* xs[kSsimWindow];
     const T* ys[kSsimWindow];
     for (int k = 0; k < kSsimWindow; ++k) {
       xs[k] = padded_x_.data() + k;
       ys[k] = padded_y_.data() + k;
     }
-    rows_.moments(window<T>().tap, xs, ys, width_, ring_rows(r));
+    in_.rows.moments(window<T>().tap, xs, ys, in_.width, ring_rows(r));
   }
 
   double column_pass(int r, int c) {
-    const int width = width_;
+    const int width = in_.width;
     const T* rows[kMomentPlanes][kSsimWindow];
     for (int plane = 0; plane < kMomentPlanes; ++plane) ring_.column(r, plane, rows[plane]);
     T* s = stats_.data();
     const MomentRows<T> stats{s, s + width, s + 2 * width, s + 3 * width};
-    rows_.sub_window_moments(window<T>().tap, rows[0], rows[1], rows[2], rows[3], width, stats);
+    in_.rows.sub_window_moments(window<T>().tap, rows[0], rows[1], rows[2], rows[3], width, stats);
 
     // Value then the kPartialPlanes derivatives, one row each; the derivatives straight into
     // the partials when the backward pass wants them.
     T* values = points_.data();
     T* d[kPartialPlanes];
     for (int plane = 0; plane < kPartialPlanes; ++plane)
-      d[plane] = partials_
-                     ? partials_ + plane * shape_.values() + row_offset(shape_, c, r) + box_.col0
-                     : values + size_t(1 + plane) * width;
-    rows_.points(stats, width, values, d[0], d[1], d[2]);
+      d[plane] = partials_ ? partials_ + plane * in_.shape.values() + row_offset(in_.shape, c, r) +
+                                 in_.box.col0
+                           : values + size_t(1 + plane) * width;
+    in_.rows.points(stats, width, values, d[0], d[1], d[2]);
     if (map_) {
-      const T inv_channels = T(1) / shape_.channels;
-      T* map_row = map_ + size_t(r) * shape_.width + box_.col0;
+      const T inv_channels = T(1) / in_.shape.channels;
+      T* map_row = map_ + size_t(r) * in_.shape.width + in_.box.col0;
       for (int x = 0; x < width; ++x) map_row[x] += values[x] * inv_channels;
     }
     double sum = 0;
@@ -204,13 +219,7 @@ class ForwardBox {
     return sum;
   }
 
-  SsimRows<T> rows_;
-  const T* x_;
-  const T* y_;
-  ImageShape shape_;
-  PixelBox box_;
-  int width_;
-  PaddedSpan span_;
+  BoxInputs<T> in_;
   T* map_;
   T* partials_;
   RowRing<T> ring_;
@@ -224,72 +233,60 @@ class ForwardBox {
 template <typename T>
 class BackwardBox {
  public:
-  BackwardBox(const SsimRows<T>& rows, const T* x, const T* y, const ImageShape& shape,
-              const PixelBox& box, const T* partials, const T* weight, T* grad_x)
-      : rows_(rows),
-        x_(x),
-        y_(y),
-        shape_(shape),
-        box_(box),
-        width_(box.col1 - box.col0),
-        span_(padded_span(shape, box)),
+  BackwardBox(const BoxInputs<T>& in, const T* partials, const T* weight, T* grad_x)
+      : in_(in),
         partials_(partials),
         weight_(weight),
         grad_x_(grad_x),
-        ring_(kPartialPlanes, width_),
-        padded_(size_t(kPartialPlanes) * (width_ + 2 * kRadius), T(0)),
-        blurred_(size_t(kPartialPlanes) * width_) {}
+        ring_(kPartialPlanes, in.width),
+        padded_(size_t(kPartialPlanes) * (in.width + 2 * kRadius), T(0)),
+        blurred_(size_t(kPartialPlanes) * in.width) {}
 
   void run() {
-    for (int c = 0; c < shape_.channels; ++c)
+    for (int c = 0; c < in_.shape.channels; ++c)
       sweep(
-          box_.row0, box_.row1, [&](int r) { row_pass(r, c); }, [&](int r) { column_pass(r, c); });
+          in_.box.row0, in_.box.row1, [&](int r) { row_pass(r, c); },
+          [&](int r) { column_pass(r, c); });
   }
 
  private:
   void row_pass(int r, int c) {
-    if (r < 0 || r >= shape_.height) {
+    if (r < 0 || r >= in_.shape.height) {
       ring_.clear(r);
       return;
     }
-    const T inv_channels = T(1) / shape_.channels;
-    const T* weight = weight_ + size_t(r) * shape_.width + span_.first;
+    const T inv_channels = T(1) / in_.shape.channels;
+    const T* weight = weight_ + size_t(r) * in_.shape.width + in_.span.first;
     for (int plane = 0; plane < kPartialPlanes; ++plane) {
-      T* padded = padded_.data() + size_t(plane) * (width_ + 2 * kRadius);
+      T* padded = padded_.data() + size_t(plane) * (in_.width + 2 * kRadius);
       const T* partial =
-          partials_ + plane * shape_.values() + row_offset(shape_, c, r) + span_.first;
-      T* in_image = padded + span_.padded_offset;
+          partials_ + plane * in_.shape.values() + row_offset(in_.shape, c, r) + in_.span.first;
+      T* in_image = padded + in_.span.padded_offset;
       // Partials are only written where some weight is, and may be garbage elsewhere.
-      for (int x = 0; x < span_.count; ++x)
+      for (int x = 0; x < in_.span.count; ++x)
         in_image[x] = weight[x] != T(0) ? weight[x] * inv_channels * partial[x] : T(0);
       const T* rows[kSsimWindow];
       for (int k = 0; k < kSsimWindow; ++k) rows[k] = padded + k;
-      rows_.blur(window<T>().tap, rows, width_, ring_.row(r, plane));
+      in_.rows.blur(window<T>().tap, rows, in_.width, ring_.row(r, plane));
     }
   }
 
   void column_pass(int r, int c) {
-    const int width = width_;
+    const int width = in_.width;
     for (int plane = 0; plane < kPartialPlanes; ++plane) {
       const T* rows[kSsimWindow];
       ring_.column(r, plane, rows);
-      rows_.blur(window<T>().tap, rows, width, blurred_.data() + size_t(plane) * width);
+      in_.rows.blur(window<T>().tap, rows, width, blurred_.data() + size_t(plane) * width);
     }
     const T* d_mean = blurred_.data();
     const T* d_square = d_mean + width;
     const T* d_cross = d_square + width;
-    const size_t offset = row_offset(shape_, c, r) + box_.col0;
-    rows_.add_gradient(d_mean, d_square, d_cross, x_ + offset, y_ + offset, width,
-                       grad_x_ + offset);
+    const size_t offset = row_offset(in_.shape, c, r) + in_.box.col0;
+    in_.rows.add_gradient(d_mean, d_square, d_cross, in_.x + offset, in_.y + offset, width,
+                          grad_x_ + offset);
   }
 
-  SsimRows<T> rows_;
-  const T* x_;
-  const T* y_;
-  ImageShape shape_;
-  PixelBox box_;
-  int width_;
-  PaddedSpan span_;
+  BoxInputs<T> in_;
   const T* partials_;
   const T* weight_;
   T* grad_x_;
@@ -356,7 +353,7 @@ double ssim_in(const T* x, const T* y, const ImageShape& shape, const std::vecto
   std::vector<double> box_sums(boxes.size(), 0.0);
   const SsimRows<T> rows = active_rows<T>();
   for_each_box(boxes, [&](int64_t i, const PixelBox& box) {
-    box_sums[i] = ForwardBox<T>(rows, x, y, shape, box, map, partials).run();
+    box_sums[i] = ForwardBox<T>({rows, x, y, shape, box}, map, partials).run();
   });
   double sum = 0;
   for (double s : box_sums) sum += s;
@@ -370,7 +367,7 @@ void ssim_backward_in(const T* x, const T* y, const ImageShape& shape,
   check_shape(shape, "ssim_backward");
   const SsimRows<T> rows = active_rows<T>();
   for_each_box(boxes, [&](int64_t, const PixelBox& box) {
-    BackwardBox<T>(rows, x, y, shape, box, partials, weight, grad_x).run();
+    BackwardBox<T>({rows, x, y, shape, box}, partials, weight, grad_x).run();
   });
 }
 
