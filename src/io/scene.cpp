@@ -95,6 +95,17 @@ void require_training_views(const Scene& scene) {
                                       scene.format == "blender"
                                           ? "NeRF-Synthetic scenes train on transforms_train.json"
                                           : "this format holds out every --test-every-th image"));
+  // 3DGS scales its position learning rate and densification by the spread of the training
+  // cameras: views from one position give it none, and no Gaussian would move.
+  const SceneNormalization sphere = scene.normalization();
+  if (sphere.radius > 1e-9 * (1 + sphere.center.norm())) return;
+  const size_t count = scene.split(Split::Train).size();
+  const std::string views = count == 1 ? std::string("the only training view is")
+                                       : fmt::format("all {} training views are", count);
+  fail_file(scene.root, fmt::format("{} taken from one position ({:.6g}, {:.6g}, {:.6g}): Gaussian "
+                                    "splatting needs views from different positions, to see "
+                                    "depth and to take the scene's scale from their spread",
+                                    views, sphere.center.x, sphere.center.y, sphere.center.z));
 }
 
 Scene load_scene(const fs::path& given_root, const SceneOptions& options) {

@@ -50,7 +50,8 @@ Scene load_scene(const std::filesystem::path& root, const SceneOptions& options 
 // Whether load_scene would recognise a format at `path` (a plain folder of images is not a scene).
 bool is_scene(const std::filesystem::path& path);
 
-// Throws Error naming the scene when it has no training view (every image held out for testing).
+// Throws Error naming the scene when it has no training view (every image held out for testing),
+// or when every training view is taken from one position.
 void require_training_views(const Scene& scene);
 
 }  // namespace iesrgs

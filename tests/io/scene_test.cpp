@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.hpp"
@@ -58,6 +60,26 @@ TEST(Scene, ASceneWithoutTrainingViewsNamesItself) {
   const std::string message = error_message([&] { require_training_views(scene); });
   EXPECT_TRUE(contains(message, "no training views: all 3 images are test views")) << message;
   EXPECT_TRUE(contains(message, (dir / "scene").string())) << message;
+}
+
+TEST(Scene, TrainingViewsFromOnePositionAreRefused) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 1, 1});
+  const std::string message =
+      error_message([&] { require_training_views(load_scene(dir / "scene")); });
+  EXPECT_TRUE(contains(message, "the only training view is taken from one position")) << message;
+  EXPECT_TRUE(contains(message, (dir / "scene").string())) << message;
+
+  // A camera turning in place: three directions, one center.
+  Scene turning;
+  for (double turn : {0.0, 1.0, 2.0}) {
+    Camera camera;
+    camera.rotation = quat_to_rotation(std::cos(turn / 2), 0, std::sin(turn / 2), 0);
+    camera.translation = -(camera.rotation * Vec3{1, 2, 3});
+    turning.cameras.push_back(camera);
+  }
+  EXPECT_TRUE(contains(error_message([&] { require_training_views(turning); }),
+                       "all 3 training views are taken from one position (1, 2, 3)"));
 }
 
 }  // namespace
