@@ -27,10 +27,23 @@ constexpr const char* kTinySchedule =
     " --sr-model bicubic --iterations 20 --internal-iterations 20 --set random_points=1500"
     " --internal-set random_points=1500 --diagnostic-views 2 --lpips none";
 
-TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
+// Each test's folder: the synthetic scene in `scene`, the run in `out`.
+class RunCli : public ::testing::Test {
+ protected:
+  // Writes the scene (seed 3); returns the exit status of synth.
+  int write_scene(int size, int views, int test_views) {
+    return iesrgs("synth -o " + scene + " --size " + std::to_string(size) + " --views " +
+                  std::to_string(views) + " --test-views " + std::to_string(test_views) +
+                  " --seed 3")
+        .status;
+  }
+
   TempDir dir;
   const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
-  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 48 --views 6 --test-views 2 --seed 3").status, 0);
+};
+
+TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
+  ASSERT_EQ(write_scene(48, 6, 2), 0);
   const std::string command =
       "run " + scene + " -o " + out + " --rows demo,hr,joint,mask-oracle" + kTinySchedule;
   const CliRun first = iesrgs(command);
@@ -111,10 +124,8 @@ TEST(RunCli, RunsEveryStageAndRowThenReusesThem) {
   EXPECT_EQ(table(), (Table{{"external", false}}));
 }
 
-TEST(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
-  TempDir dir;
-  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
-  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 1 --seed 3").status, 0);
+TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
   const CliRun fuse = iesrgs("fuse " + scene + " -o " + out + kTinySchedule);
   EXPECT_EQ(fuse.status, 1);
   EXPECT_TRUE(contains(last_line(fuse.output), "external.json: missing")) << fuse.output;
@@ -134,10 +145,8 @@ TEST(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_FALSE(std::filesystem::exists(dir / "run" / "results.json"));
 }
 
-TEST(RunCli, IeSrgsRowOffTheMaskIsLabelledByItsTexture) {
-  TempDir dir;
-  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
-  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 1 --seed 3").status, 0);
+TEST_F(RunCli, IeSrgsRowOffTheMaskIsLabelledByItsTexture) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
   const CliRun run =
       iesrgs("run " + scene + " -o " + out + " --rows ie-srgs --texture external" + kTinySchedule);
   ASSERT_EQ(run.status, 0) << run.output;
@@ -147,10 +156,8 @@ TEST(RunCli, IeSrgsRowOffTheMaskIsLabelledByItsTexture) {
   EXPECT_EQ(results["rows"][0]["label"], "IE-SRGS, external texture (no mask)");
 }
 
-TEST(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
-  TempDir dir;
-  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
-  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 5 --test-views 1 --seed 3").status, 0);
+TEST_F(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
+  ASSERT_EQ(write_scene(16, 5, 1), 0);
   // The folder's earlier table, from a benchmark of the same images, has an hr row.
   ASSERT_EQ(iesrgs("run " + scene + " -o " + out + " --rows hr" + kTinySchedule).status, 0);
   const CliRun run = iesrgs("run " + scene + " -o " + out + " --input-is-lr" + kTinySchedule);
@@ -171,10 +178,8 @@ TEST(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
 
 // Rows that start from the internal model train a copy: the internal-only row, evaluated after
 // the bicubic row trained from it, still renders the model as the internal stage left it.
-TEST(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
-  TempDir dir;
-  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
-  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 2 --seed 3").status, 0);
+TEST_F(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
+  ASSERT_EQ(write_scene(32, 4, 2), 0);
   const auto internal_psnr = [&] {
     const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
     for (const auto& row : results["rows"])
@@ -192,10 +197,8 @@ TEST(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
 
 // A run that trains the internal model again under other settings drops the internal-only row
 // that scored the old one.
-TEST(RunCli, RetrainedInternalModelDropsTheEarlierInternalRow) {
-  TempDir dir;
-  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
-  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 1 --seed 3").status, 0);
+TEST_F(RunCli, RetrainedInternalModelDropsTheEarlierInternalRow) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
   const std::string rows = "run " + scene + " -o " + out + " --rows ";
   ASSERT_EQ(iesrgs(rows + "internal,external" + kTinySchedule).status, 0);
   const CliRun retrained = iesrgs(rows + "joint --internal-set seed=7" + kTinySchedule);
@@ -208,10 +211,8 @@ TEST(RunCli, RetrainedInternalModelDropsTheEarlierInternalRow) {
 
 // Earlier rows scored against test views that changed since leave the table, the internal-only
 // row too, though its model learnt from the unchanged training views.
-TEST(RunCli, RowsScoredAgainstOtherTestViewsLeaveTheTable) {
-  TempDir dir;
-  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
-  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 32 --views 4 --test-views 1 --seed 3").status, 0);
+TEST_F(RunCli, RowsScoredAgainstOtherTestViewsLeaveTheTable) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
   const std::string rows = "run " + scene + " -o " + out + " --rows ";
   ASSERT_EQ(iesrgs(rows + "internal,bicubic" + kTinySchedule).status, 0);
   const auto test_image = dir / "scene/test/r_0.png";
@@ -228,15 +229,10 @@ TEST(RunCli, RowsScoredAgainstOtherTestViewsLeaveTheTable) {
 // Caches follow the images' content, not their folder: rewriting the same bytes (a copied
 // dataset) or moving the dataset reuses every stage; an edited training image recomputes its
 // E_image, the internal model and the rows, and so does another background.
-TEST(RunCli, EditedTrainingImageRecomputesWhatLearntFromIt) {
-  TempDir dir;
-  const std::string out = (dir / "run").string();
-  ASSERT_EQ(iesrgs("synth -o " + (dir / "scene").string() +
-                   " --size 32 --views 4 --test-views 1 --seed 3")
-                .status,
-            0);
-  const auto command = [&](const std::string& scene, const std::string& extra = "") {
-    return "run " + (dir / scene).string() + " -o " + out + " --rows ie-srgs,hr" + kTinySchedule +
+TEST_F(RunCli, EditedTrainingImageRecomputesWhatLearntFromIt) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
+  const auto command = [&](const std::string& folder, const std::string& extra = "") {
+    return "run " + (dir / folder).string() + " -o " + out + " --rows ie-srgs,hr" + kTinySchedule +
            extra;
   };
   ASSERT_EQ(iesrgs(command("scene")).status, 0);
