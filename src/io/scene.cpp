@@ -100,11 +100,12 @@ void require_training_views(const Scene& scene) {
   const SceneNormalization sphere = scene.normalization();
   if (sphere.radius > 1e-9 * (1 + sphere.center.norm())) return;
   const size_t count = scene.split(Split::Train).size();
-  const std::string views = count == 1 ? std::string("the only training view is")
-                                       : fmt::format("all {} training views are", count);
-  fail_file(scene.root, fmt::format("{} taken from one position ({:.6g}, {:.6g}, {:.6g}): Gaussian "
-                                    "splatting needs views from different positions, to see "
-                                    "depth and to take the scene's scale from their spread",
+  const std::string views = count == 1
+                                ? "a single training view, at"
+                                : fmt::format("all {} training views at one position,", count);
+  fail_file(scene.root, fmt::format("{} ({:.6g}, {:.6g}, {:.6g}): Gaussian splatting needs views "
+                                    "from different positions, to see depth and to take the "
+                                    "scene's scale from their spread",
                                     views, sphere.center.x, sphere.center.y, sphere.center.z));
 }
 

@@ -67,7 +67,7 @@ TEST(Scene, TrainingViewsFromOnePositionAreRefused) {
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 1, 1});
   const std::string message =
       error_message([&] { require_training_views(load_scene(dir / "scene")); });
-  EXPECT_TRUE(contains(message, "the only training view is taken from one position")) << message;
+  EXPECT_TRUE(contains(message, "a single training view, at (")) << message;
   EXPECT_TRUE(contains(message, (dir / "scene").string())) << message;
 
   // A camera turning in place: three directions, one center.
@@ -79,7 +79,7 @@ TEST(Scene, TrainingViewsFromOnePositionAreRefused) {
     turning.cameras.push_back(camera);
   }
   EXPECT_TRUE(contains(error_message([&] { require_training_views(turning); }),
-                       "all 3 training views are taken from one position (1, 2, 3)"));
+                       "all 3 training views at one position, (1, 2, 3)"));
 }
 
 }  // namespace
