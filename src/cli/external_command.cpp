@@ -4,6 +4,7 @@
 #include "cli/device_option.hpp"
 #include "cli/external_options.hpp"
 #include "cli/scene_options.hpp"
+#include "io/folder_lock.hpp"
 #include "pipeline/external_stage.hpp"
 
 namespace iesrgs::cli {
@@ -23,6 +24,7 @@ void run_external(const ExternalArgs& args) {
   ViewImages images(scene);
   pipeline::ExternalOptions options = args.options;
   pipeline::resolve_sr_model(options);
+  const FolderLock lock(args.output);
   pipeline::run_external_stage(scene, images, options, args.output);
 }
 

@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/memory.hpp"
 #include "io/atomic_file.hpp"
+#include "io/folder_lock.hpp"
 #include "io/json_file.hpp"
 #include "train/session.hpp"
 
@@ -72,6 +73,8 @@ void run_train(const TrainArgs& args) {
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   ViewImages images(scene);
   train::TrainerSetup setup = train::scene_setup(scene, images, size_t(config.test_views), out);
+  // Once the scene has loaded, so that a refused input leaves no folder behind.
+  const FolderLock lock(out);
   const int width = setup.train_views.front().camera.intrinsics.width;
   const int height = setup.train_views.front().camera.intrinsics.height;
   fmt::print("training on {} views ({}x{}), {} test views; preset {}, {} iterations, K = {}\n",

@@ -12,6 +12,7 @@
 #include "eval/mask_agreement.hpp"
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
+#include "io/folder_lock.hpp"
 #include "io/image_tensor.hpp"
 #include "io/view_images.hpp"
 #include "loss/texture_fusion.hpp"
@@ -602,6 +603,8 @@ std::string describe_rows() {
 
 RunResult run_ie_srgs(const RunOptions& options) {
   Pipeline pipeline(options);
+  // Taken once the scenes have loaded, so that a run refused for its input leaves no folder.
+  const FolderLock lock(options.output);
   RunResult result = pipeline.run();
   if (result.rows.empty()) return result;
   write_results(options.output, result);

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.hpp"
+#include "io/folder_lock.hpp"
 #include "io/image.hpp"
 #include "io/ply.hpp"
 #include "support/cli_run.hpp"
@@ -146,6 +147,24 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   EXPECT_EQ(reseeded.status, 1);
   EXPECT_TRUE(contains(last_line(reseeded.output), "--seed cannot change a resumed run"))
       << reseeded.output;
+}
+
+// A second process writing into a folder in use (a resume started while the run goes on) would
+// interleave checkpoints and logs.
+TEST(TrainCli, AFolderInUseIsRefused) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 3 --test-views 1").status, 0);
+  const FolderLock held(dir / "run");
+  for (const std::string& command : {"train " + scene + " -o " + out + " --iterations 10",
+                                     "run " + scene + " -o " + out + " --sr-model bicubic",
+                                     "external " + scene + " -o " + out + " --sr-model bicubic"}) {
+    const CliRun refused = iesrgs(command);
+    EXPECT_EQ(refused.status, 1) << command;
+    EXPECT_TRUE(contains(last_line(refused.output), out + ": in use by another iesrgs process"))
+        << refused.output;
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir / "run"));
 }
 
 TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {

@@ -1,0 +1,24 @@
+#pragma once
+// An output folder is written by one process at a time: a second `train` or `run` into the same
+// folder (a resume started while the first still runs, say) would interleave checkpoints, logs
+// and cached stages.
+#include <filesystem>
+
+namespace iesrgs {
+
+// Creates `folder` if needed and holds an exclusive lock on it until destroyed. The kernel
+// drops the lock when the process ends, however it ends, so a crash leaves nothing stale.
+// Throws Error naming the folder when another process holds it. On a file system without
+// locks, the folder is used unlocked.
+class FolderLock {
+ public:
+  explicit FolderLock(const std::filesystem::path& folder);
+  ~FolderLock();
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace iesrgs
