@@ -95,6 +95,10 @@ void require_training_views(const Scene& scene) {
                                       scene.format == "blender"
                                           ? "NeRF-Synthetic scenes train on transforms_train.json"
                                           : "this format holds out every --test-every-th image"));
+}
+
+void require_trainable_views(const Scene& scene) {
+  require_training_views(scene);
   // 3DGS scales its position learning rate and densification by the spread of the training
   // cameras: views from one position give it none, and no Gaussian would move.
   const SceneNormalization sphere = scene.normalization();

@@ -50,8 +50,10 @@ Scene load_scene(const std::filesystem::path& root, const SceneOptions& options 
 // Whether load_scene would recognise a format at `path` (a plain folder of images is not a scene).
 bool is_scene(const std::filesystem::path& path);
 
-// Throws Error naming the scene when it has no training view (every image held out for testing),
-// or when every training view is taken from one position.
+// Throws Error naming the scene when it has no training view (every image held out for testing).
 void require_training_views(const Scene& scene);
+
+// The same, and also when every training view is taken from one position: nothing to train on.
+void require_trainable_views(const Scene& scene);
 
 }  // namespace iesrgs

@@ -183,7 +183,7 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
     lr_options.downscale *= o_.scale;
   }
   lr_scene_ = load_scene(o_.scene, lr_options);
-  require_training_views(lr_scene_);
+  require_trainable_views(lr_scene_);
   lr_images_ = std::make_unique<ViewImages>(lr_scene_);
   threshold_ = o_.threshold >= 0     ? o_.threshold
                : lr_scene_.synthetic ? loss::kDiscrepancyThresholdSynthetic

@@ -34,7 +34,7 @@ std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& i
 
 TrainerSetup scene_setup(const Scene& scene, ViewImages& images, size_t test_views,
                          const std::filesystem::path& output_dir) {
-  require_training_views(scene);
+  require_trainable_views(scene);
   TrainerSetup setup;
   setup.train_views = load_views(scene, Split::Train, images);
   setup.test_views = load_views(scene, Split::Test, images, test_views);
