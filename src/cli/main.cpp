@@ -8,6 +8,7 @@
 
 #include "cli/commands.hpp"
 #include "core/device.hpp"
+#include "core/error.hpp"
 #include "core/torch_error.hpp"
 
 int main(int argc, char** argv) {
