@@ -62,10 +62,11 @@ class GroundTruth {
   // The scene views of the split that no render was scored against (none for a plain folder).
   std::vector<std::string> unscored(const std::vector<eval::ViewMetrics>& scored) const {
     std::vector<std::string> names;
-    for (const auto& [name, camera] : cameras_)
+    // By entry, not structured binding: C++17 lambdas cannot capture a binding.
+    for (const auto& entry : cameras_)
       if (std::none_of(scored.begin(), scored.end(),
-                       [&](const eval::ViewMetrics& v) { return v.name == name; }))
-        names.push_back(name);
+                       [&](const eval::ViewMetrics& v) { return v.name == entry.first; }))
+        names.push_back(entry.first);
     return names;
   }
 

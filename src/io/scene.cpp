@@ -100,7 +100,7 @@ void require_training_views(const Scene& scene) {
 void require_trainable_views(const Scene& scene) {
   require_training_views(scene);
   // 3DGS scales its position learning rate and densification by the spread of the training
-  // cameras: views from one position give it none, and no Gaussian would move.
+  // cameras: views from one position give it none, and no position would be optimized.
   const SceneNormalization sphere = scene.normalization();
   if (sphere.radius > 1e-9 * (1 + sphere.center.norm())) return;
   const size_t count = scene.split(Split::Train).size();
