@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "gs/model.hpp"
 #include "io/atomic_file.hpp"
+#include "io/folder_lock.hpp"
 #include "io/model_file.hpp"
 #include "pipeline/camera_path.hpp"
 #include "pipeline/render_views.hpp"
@@ -60,6 +61,8 @@ void run_render(const RenderArgs& args) {
     fail("--scale {}: the {} views would be {:.0f}x{:.0f} pixels (1 to 65536 a side)", args.scale,
          what, width, height);
   const Camera first = cameras.front().scaled(args.scale);
+  // Two renders into one folder would leave a mix of two models' views.
+  const FolderLock lock(args.output);
   const char* mode = model.antialiased ? "antialiased" : "classic";
   fmt::print("rendering {} {} views of {} Gaussians at x{} ({})\n", cameras.size(), what,
              model.size(), args.scale, mode);

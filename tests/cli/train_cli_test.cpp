@@ -154,11 +154,14 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
 TEST(TrainCli, AFolderInUseIsRefused) {
   TempDir dir;
   const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  const std::string model = (dir / "model").string();
   ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 3 --test-views 1").status, 0);
+  ASSERT_EQ(iesrgs("train " + scene + " -o " + model + " --iterations 10").status, 0);
   const FolderLock held(dir / "run");
   for (const std::string& command : {"train " + scene + " -o " + out + " --iterations 10",
                                      "run " + scene + " -o " + out + " --sr-model bicubic",
-                                     "external " + scene + " -o " + out + " --sr-model bicubic"}) {
+                                     "external " + scene + " -o " + out + " --sr-model bicubic",
+                                     "render " + model + " " + scene + " -o " + out}) {
     const CliRun refused = iesrgs(command);
     EXPECT_EQ(refused.status, 1) << command;
     EXPECT_TRUE(contains(last_line(refused.output), out + ": in use by another iesrgs process"))
