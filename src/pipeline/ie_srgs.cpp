@@ -377,7 +377,6 @@ RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& mo
 RowResult Pipeline::run_fusion_row(const RowSpec& row) {
   const loss::FusionWeights weights = row_weights(row);
   const fs::path dir = o_.output / "rows" / row.id;
-  fmt::print("\n== row {}: {} ==\n", row.id, row_label(row));
   FusionSetup setup = fusion_setup(row, weights);
   const FusionSetup diagnostics_setup = std::string(row.id) == "ie-srgs" ? setup : FusionSetup{};
   const StageResult stage =
@@ -471,13 +470,24 @@ RunResult Pipeline::run() {
   if (o_.only == StageSelection::Internal) return {{}, stages_, {}};
 
   RunResult result;
-  for (const std::string& id : rows_) {
-    const RowSpec& row = row_spec(id);
+  // The HR rows take nearly all of a run's time: say where the run stands after each of them.
+  const size_t hr_rows = size_t(std::count_if(rows_.begin(), rows_.end(), [](const auto& id) {
+    return row_spec(id).source != Source::Internal;
+  }));
+  const auto rows_start = std::chrono::steady_clock::now();
+  size_t hr_done = 0;
+  for (size_t i = 0; i < rows_.size(); ++i) {
+    const RowSpec& row = row_spec(rows_[i]);
+    fmt::print("\n== row {}/{} {}: {} ==\n", i + 1, rows_.size(), row.id, row_label(row));
     if (row.source != Source::Internal) {
       result.rows.push_back(run_fusion_row(row));
+      ++hr_done;
+      const double seconds = elapsed_since(rows_start);
+      if (hr_done < hr_rows)
+        fmt::print("HR rows: {} of {} done in {}, ETA {} for the rest\n", hr_done, hr_rows,
+                   train::format_duration(seconds), train::format_eta(hr_done, hr_rows, seconds));
       continue;
     }
-    fmt::print("\n== row {}: {} ==\n", row.id, row_label(row));
     RowResult internal = evaluate_row(row, internal_->training.model, o_.output / "rows" / row.id);
     internal.train_seconds = internal_->training.seconds;
     result.rows.push_back(internal);

@@ -49,6 +49,10 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   const CliRun first = iesrgs(command);
   ASSERT_EQ(first.status, 0) << first.output;
   EXPECT_TRUE(contains(first.output, "IE-SRGS (+ mask)")) << first.output;
+  // Seven rows, six of them trained at HR: where the run stands after each but the last.
+  EXPECT_TRUE(contains(first.output, "== row 7/7 hr: ")) << first.output;
+  EXPECT_TRUE(contains(first.output, "HR rows: 5 of 6 done in ")) << first.output;
+  EXPECT_FALSE(contains(first.output, "HR rows: 6 of 6")) << first.output;
 
   const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
   ASSERT_EQ(results["rows"].size(), 7u);
@@ -150,7 +154,7 @@ TEST_F(RunCli, IeSrgsRowOffTheMaskIsLabelledByItsTexture) {
   const CliRun run =
       iesrgs("run " + scene + " -o " + out + " --rows ie-srgs --texture external" + kTinySchedule);
   ASSERT_EQ(run.status, 0) << run.output;
-  EXPECT_TRUE(contains(run.output, "== row ie-srgs: IE-SRGS, external texture (no mask) =="))
+  EXPECT_TRUE(contains(run.output, "== row 1/1 ie-srgs: IE-SRGS, external texture (no mask) =="))
       << run.output;
   const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
   EXPECT_EQ(results["rows"][0]["label"], "IE-SRGS, external texture (no mask)");
