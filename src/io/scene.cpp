@@ -124,8 +124,14 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   require_unique_names(scene);
   scene.background = options.background;
   scene.downscale = options.downscale;
-  for (Camera& camera : scene.cameras)
+  for (Camera& camera : scene.cameras) {
     camera.intrinsics = camera.stored.scaled(1.0 / options.downscale);
+    if (camera.intrinsics.width < 1 || camera.intrinsics.height < 1)
+      fail_file(camera.image_path,
+                fmt::format("at 1/{} of its {}x{} pixels, this view would have none; use a "
+                            "smaller downscale or scale factor",
+                            options.downscale, camera.stored.width, camera.stored.height));
+  }
   return scene;
 }
 

@@ -83,5 +83,17 @@ TEST(Scene, TrainingViewsFromOnePositionAreRefused) {
                        "all 3 training views at one position, (1, 2, 3)"));
 }
 
+TEST(Scene, ADownscaleThatLeavesNoPixelIsRefused) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 1});
+  SceneOptions options;
+  options.downscale = 16;  // 8 / 16 rounds to 1 pixel: small, but a view
+  EXPECT_EQ(load_scene(dir / "scene", options).cameras.front().intrinsics.width, 1);
+  options.downscale = 17;
+  const std::string message = error_message([&] { load_scene(dir / "scene", options); });
+  EXPECT_TRUE(contains(message, "at 1/17 of its 8x8 pixels, this view would have none")) << message;
+  EXPECT_TRUE(contains(message, ".png")) << message;
+}
+
 }  // namespace
 }  // namespace iesrgs
