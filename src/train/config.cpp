@@ -69,10 +69,6 @@ int64_t scaled(int64_t steps, double ratio) {
 
 }  // namespace
 
-std::vector<std::string> preset_names() {
-  return {"paper", "cpu", "fast"};
-}
-
 TrainConfig make_preset(const std::string& name, int64_t iterations) {
   TrainConfig config;
   config.preset = name;

@@ -5,7 +5,6 @@
 
 #include <cstdint>
 #include <string>
-#include <vector>
 
 #include "gs/densify.hpp"
 #include "gs/optimizer.hpp"
@@ -51,12 +50,10 @@ struct TrainConfig {
   int64_t log_every = 10;
 };
 
-// Names of the built-in presets: "paper" (METHOD.md's 30k-iteration schedule, for GPUs) and the
-// CPU ones, which keep the algorithm and shorten the schedule.
-std::vector<std::string> preset_names();
-
-// The preset, with its schedule (densification window, opacity reset, SH steps, position decay)
-// rescaled to `iterations` when that is positive. Throws Error for an unknown name.
+// A built-in preset: "paper" (METHOD.md's 30k-iteration schedule, for GPUs), or "cpu" and "fast",
+// which keep the algorithm and shorten the schedule to 10k and 3k iterations. The preset, with its
+// schedule (densification window, opacity reset, SH steps, position decay) rescaled to `iterations`
+// when that is positive. Throws Error for an unknown name.
 TrainConfig make_preset(const std::string& name, int64_t iterations = 0);
 
 // Rescales every iteration count of the schedule so that it spans `iterations`.
