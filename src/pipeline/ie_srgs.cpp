@@ -125,6 +125,34 @@ double elapsed_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The HR rows take nearly all of a run's time: after each, where the run stands, with an ETA at
+// the pace of the rows it trained (a row reused from the cache takes seconds).
+class HrRowProgress {
+ public:
+  explicit HrRowProgress(size_t rows) : rows_(rows), start_(std::chrono::steady_clock::now()) {}
+
+  void row_done(bool trained, double seconds) {
+    ++done_;
+    if (trained) {
+      ++trained_;
+      trained_seconds_ += seconds;
+    }
+    if (done_ == rows_) return;
+    const size_t left = rows_ - done_;
+    fmt::print("HR rows: {} of {} done in {}{}\n", done_, rows_,
+               train::format_duration(elapsed_since(start_)),
+               trained_
+                   ? fmt::format(", ETA {} for the rest",
+                                 train::format_eta(trained_, trained_ + left, trained_seconds_))
+                   : "");
+  }
+
+ private:
+  size_t rows_, done_ = 0, trained_ = 0;
+  double trained_seconds_ = 0;
+  std::chrono::steady_clock::time_point start_;
+};
+
 class Pipeline {
  public:
   explicit Pipeline(const RunOptions& options);
@@ -389,6 +417,7 @@ RowResult Pipeline::run_fusion_row(const RowSpec& row) {
   }
   RowResult result = evaluate_row(row, stage.model, dir);
   result.train_seconds = stage.seconds;
+  result.trained_now = !stage.cached;
   return result;
 }
 
@@ -470,22 +499,16 @@ RunResult Pipeline::run() {
   if (o_.only == StageSelection::Internal) return {{}, stages_, {}};
 
   RunResult result;
-  // The HR rows take nearly all of a run's time: say where the run stands after each of them.
-  const size_t hr_rows = size_t(std::count_if(rows_.begin(), rows_.end(), [](const auto& id) {
+  HrRowProgress progress(size_t(std::count_if(rows_.begin(), rows_.end(), [](const auto& id) {
     return row_spec(id).source != Source::Internal;
-  }));
-  const auto rows_start = std::chrono::steady_clock::now();
-  size_t hr_done = 0;
+  })));
   for (size_t i = 0; i < rows_.size(); ++i) {
     const RowSpec& row = row_spec(rows_[i]);
     fmt::print("\n== row {}/{} {}: {} ==\n", i + 1, rows_.size(), row.id, row_label(row));
     if (row.source != Source::Internal) {
+      const auto row_start = std::chrono::steady_clock::now();
       result.rows.push_back(run_fusion_row(row));
-      ++hr_done;
-      const double seconds = elapsed_since(rows_start);
-      if (hr_done < hr_rows)
-        fmt::print("HR rows: {} of {} done in {}, ETA {} for the rest\n", hr_done, hr_rows,
-                   train::format_duration(seconds), train::format_eta(hr_done, hr_rows, seconds));
+      progress.row_done(result.rows.back().trained_now, elapsed_since(row_start));
       continue;
     }
     RowResult internal = evaluate_row(row, internal_->training.model, o_.output / "rows" / row.id);

@@ -52,6 +52,7 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   // Seven rows, six of them trained at HR: where the run stands after each but the last.
   EXPECT_TRUE(contains(first.output, "== row 7/7 hr: ")) << first.output;
   EXPECT_TRUE(contains(first.output, "HR rows: 5 of 6 done in ")) << first.output;
+  EXPECT_TRUE(contains(first.output, "for the rest")) << first.output;
   EXPECT_FALSE(contains(first.output, "HR rows: 6 of 6")) << first.output;
 
   const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
@@ -92,6 +93,9 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   ASSERT_EQ(second.status, 0) << second.output;
   EXPECT_TRUE(contains(second.output, "reusing the finished model")) << second.output;
   EXPECT_FALSE(contains(second.output, "it/s |")) << second.output;
+  // No row trained, so no pace to give an ETA by.
+  EXPECT_TRUE(contains(second.output, "HR rows: 5 of 6 done in ")) << second.output;
+  EXPECT_FALSE(contains(second.output, "for the rest")) << second.output;
 
   // Rerunning one row keeps the rest of the folder's table.
   using Table = std::vector<std::pair<std::string, bool>>;
