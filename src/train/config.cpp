@@ -150,12 +150,27 @@ void validate(const TrainConfig& c) {
   require(c.log_every > 0, "log_every must be positive");
   require(c.checkpoint_every >= 0 && c.test_every >= 0 && c.test_views >= 0,
           "checkpoint_every, test_every and test_views must not be negative");
+  require(c.densify_from >= 0 && c.densify_until >= 0,
+          "densify_from and densify_until must not be negative");
   require(c.grad_threshold > 0, "grad_threshold must be positive");
+  require(c.percent_dense >= 0, "percent_dense must not be negative");
+  require(c.min_opacity >= 0 && c.min_opacity < 1, "min_opacity must be in [0, 1)");
+  require(c.max_screen_size >= 0 && c.max_world_size >= 0,
+          "max_screen_size and max_world_size must be 0 (off) or positive");
   require(c.max_gaussians >= 0, "max_gaussians must be 0 (no cap) or positive");
   require(c.init == "auto" || c.init == "random", "init must be \"auto\" or \"random\"");
   require(c.random_points > 0, "random_points must be positive");
   require(c.random_extent >= 0, "random_extent must be 0 (from the scene) or positive");
-  require(c.learning_rates.position_max_steps > 0, "lr_position_max_steps must be positive");
+  const gs::LearningRates& lr = c.learning_rates;
+  require(lr.position_max_steps > 0, "lr_position_max_steps must be positive");
+  // The position rate decays log-linearly between the two: a zero at one end is zero throughout.
+  require((lr.position_initial > 0 && lr.position_final > 0) ||
+              (lr.position_initial == 0 && lr.position_final == 0),
+          "lr_position_initial and lr_position_final must both be positive, or both 0 (positions "
+          "held fixed)");
+  require(
+      lr.sh_dc >= 0 && lr.sh_rest >= 0 && lr.opacity >= 0 && lr.scaling >= 0 && lr.rotation >= 0,
+      "learning rates must not be negative (0 holds a parameter fixed)");
 }
 
 }  // namespace iesrgs::train

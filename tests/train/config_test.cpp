@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <utility>
+
 #include "support/expect_error.hpp"
 
 namespace iesrgs::train {
@@ -73,6 +75,23 @@ TEST(TrainConfig, BadInputNamesTheProblem) {
   EXPECT_NE(error_message([] { make_preset("turbo"); }).find("turbo"), std::string::npos);
   c.views_per_iteration = 0;
   EXPECT_NE(error_message([&] { validate(c); }).find("views_per_iteration"), std::string::npos);
+}
+
+TEST(TrainConfig, OutOfRangeValuesNameTheParameter) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"percent_dense=-1", "percent_dense"},     {"min_opacity=1.5", "min_opacity"},
+      {"max_world_size=-0.1", "max_world_size"}, {"densify_until=-5", "densify_until"},
+      {"lr_scaling=-0.1", "learning rates"},     {"lr_position_final=0", "lr_position_final"}};
+  for (const auto& [assignment, named] : cases) {
+    TrainConfig c;
+    validate(c);
+    apply_assignment(c, assignment);
+    EXPECT_NE(error_message([&] { validate(c); }).find(named), std::string::npos) << assignment;
+  }
+  TrainConfig fixed_positions;
+  apply_assignment(fixed_positions, "lr_position_initial=0");
+  apply_assignment(fixed_positions, "lr_position_final=0");
+  validate(fixed_positions);
 }
 
 }  // namespace
