@@ -13,9 +13,14 @@
 
 namespace iesrgs {
 
-FolderLock::FolderLock(const std::filesystem::path& folder) {
+namespace fs = std::filesystem;
+
+FolderLock::FolderLock(const fs::path& folder) {
   std::error_code ec;
-  std::filesystem::create_directories(folder, ec);
+  for (fs::path missing = folder; !missing.empty() && !fs::exists(missing, ec);
+       missing = missing.parent_path())
+    created_.push_back(missing);
+  fs::create_directories(folder, ec);
   if (ec) fail_file(folder, "cannot create the output folder (" + ec.message() + ")");
   // A directory can be locked itself: no lock file is left among the outputs.
   fd_ = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -32,6 +37,10 @@ FolderLock::FolderLock(const std::filesystem::path& folder) {
 }
 
 FolderLock::~FolderLock() {
+  // Still holding the lock, so that no other process starts writing in between.
+  std::error_code ec;
+  for (const fs::path& folder : created_)
+    if (!fs::remove(folder, ec)) break;  // not empty: this and every parent stay
   if (fd_ >= 0) ::close(fd_);
 }
 

@@ -3,13 +3,15 @@
 // folder (a resume started while the first still runs, say) would interleave checkpoints, logs
 // and cached stages.
 #include <filesystem>
+#include <vector>
 
 namespace iesrgs {
 
 // Creates `folder` if needed and holds an exclusive lock on it until destroyed. The kernel
 // drops the lock when the process ends, however it ends, so a crash leaves nothing stale.
 // Throws Error naming the folder when another process holds it. On a file system without
-// locks, the folder is used unlocked.
+// locks, the folder is used unlocked. Folders it created that are still empty when it is
+// released are removed, so a command refused after taking the lock leaves no trace.
 class FolderLock {
  public:
   explicit FolderLock(const std::filesystem::path& folder);
@@ -19,6 +21,7 @@ class FolderLock {
 
  private:
   int fd_ = -1;
+  std::vector<std::filesystem::path> created_;  // the folder first, then its new parents
 };
 
 }  // namespace iesrgs

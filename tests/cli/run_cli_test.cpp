@@ -137,6 +137,7 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   const CliRun fuse = iesrgs("fuse " + scene + " -o " + out + kTinySchedule);
   EXPECT_EQ(fuse.status, 1);
   EXPECT_TRUE(contains(last_line(fuse.output), "external.json: missing")) << fuse.output;
+  EXPECT_FALSE(std::filesystem::exists(out));  // refused: no empty run folder left behind
 
   const CliRun rows = iesrgs("run " + scene + " -o " + out + " --rows best" + kTinySchedule);
   EXPECT_EQ(rows.status, 1);
@@ -151,6 +152,20 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   ASSERT_EQ(internal.status, 0) << internal.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "run" / "internal/sr/rgb/r_0.png"));
   EXPECT_FALSE(std::filesystem::exists(dir / "run" / "results.json"));
+}
+
+// The SR network loads only once the stage has found a view to compute, after the output folder
+// was taken.
+TEST_F(RunCli, AMissingCheckpointLeavesNoOutputFolder) {
+  ASSERT_EQ(write_scene(16, 3, 1), 0);
+  for (const std::string command : {"run", "external"}) {
+    const CliRun refused =
+        iesrgs(command + " " + scene + " -o " + out + "/nested --sr-model swinir");
+    EXPECT_EQ(refused.status, 1) << command;
+    EXPECT_TRUE(contains(last_line(refused.output), "swinir: no checkpoint file given"))
+        << refused.output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << command;
+  }
 }
 
 TEST_F(RunCli, IeSrgsRowOffTheMaskIsLabelledByItsTexture) {

@@ -27,6 +27,20 @@ TEST(FolderLock, OneHolderAtATime) {
   EXPECT_TRUE(std::filesystem::is_empty(folder));  // no lock file among the outputs
 }
 
+TEST(FolderLock, FoldersItCreatedAndLeftEmptyAreRemoved) {
+  TempDir dir;
+  { FolderLock unused(dir / "new" / "run"); }
+  EXPECT_FALSE(std::filesystem::exists(dir / "new"));
+  {
+    FolderLock written(dir / "kept" / "run");
+    std::ofstream(dir / "kept" / "run" / "out.txt") << "x";
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir / "kept" / "run" / "out.txt"));
+  std::filesystem::create_directory(dir / "given");
+  { FolderLock unused(dir / "given"); }
+  EXPECT_TRUE(std::filesystem::is_directory(dir / "given"));  // the user's own folder stays
+}
+
 TEST(FolderLock, AFileInTheWayIsNamed) {
   TempDir dir;
   const auto file = dir / "taken";
