@@ -22,6 +22,7 @@
 #include "pipeline/internal_stage.hpp"
 #include "pipeline/render_views.hpp"
 #include "pipeline/stage_record.hpp"
+#include "pipeline/training_stage.hpp"
 #include "train/progress.hpp"
 #include "train/session.hpp"
 
@@ -125,30 +126,34 @@ double elapsed_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The HR rows take nearly all of a run's time: after each, where the run stands, with an ETA at
-// the pace of the rows it trained (a row reused from the cache takes seconds).
+// The HR rows take nearly all of a run's time: after each, where the run stands, with an ETA for
+// the rows left to train at the pace of those trained so far (a row reused from the cache takes
+// seconds, and is counted in neither).
 class HrRowProgress {
  public:
-  explicit HrRowProgress(size_t rows) : rows_(rows), start_(std::chrono::steady_clock::now()) {}
+  // Whether each HR row, in order, has to train: its stage is not cached.
+  explicit HrRowProgress(std::vector<bool> trains)
+      : trains_(std::move(trains)), start_(std::chrono::steady_clock::now()) {}
 
-  void row_done(bool trained, double seconds) {
-    ++done_;
-    if (trained) {
+  void row_done(double seconds) {
+    if (trains_[done_++]) {
       ++trained_;
       trained_seconds_ += seconds;
     }
-    if (done_ == rows_) return;
-    const size_t left = rows_ - done_;
-    fmt::print("HR rows: {} of {} done in {}{}\n", done_, rows_,
+    if (done_ == trains_.size()) return;
+    const auto left =
+        size_t(std::count(trains_.begin() + std::ptrdiff_t(done_), trains_.end(), true));
+    fmt::print("HR rows: {} of {} done in {}{}\n", done_, trains_.size(),
                train::format_duration(elapsed_since(start_)),
-               trained_
+               trained_ && left
                    ? fmt::format(", ETA {} for the rest",
                                  train::format_eta(trained_, trained_ + left, trained_seconds_))
                    : "");
   }
 
  private:
-  size_t rows_, done_ = 0, trained_ = 0;
+  std::vector<bool> trains_;
+  size_t done_ = 0, trained_ = 0;
   double trained_seconds_ = 0;
   std::chrono::steady_clock::time_point start_;
 };
@@ -417,7 +422,6 @@ RowResult Pipeline::run_fusion_row(const RowSpec& row) {
   }
   RowResult result = evaluate_row(row, stage.model, dir);
   result.train_seconds = stage.seconds;
-  result.trained_now = !stage.cached;
   return result;
 }
 
@@ -499,16 +503,19 @@ RunResult Pipeline::run() {
   if (o_.only == StageSelection::Internal) return {{}, stages_, {}};
 
   RunResult result;
-  HrRowProgress progress(size_t(std::count_if(rows_.begin(), rows_.end(), [](const auto& id) {
-    return row_spec(id).source != Source::Internal;
-  })));
+  std::vector<bool> hr_rows_to_train;
+  for (const std::string& id : rows_)
+    if (const RowSpec& row = row_spec(id); row.source != Source::Internal)
+      hr_rows_to_train.push_back(!training_stage_current(
+          o_.output / "rows" / row.id, row_params(row, row_weights(row)), o_.fusion_config));
+  HrRowProgress progress(std::move(hr_rows_to_train));
   for (size_t i = 0; i < rows_.size(); ++i) {
     const RowSpec& row = row_spec(rows_[i]);
     fmt::print("\n== row {}/{} {}: {} ==\n", i + 1, rows_.size(), row.id, row_label(row));
     if (row.source != Source::Internal) {
       const auto row_start = std::chrono::steady_clock::now();
       result.rows.push_back(run_fusion_row(row));
-      progress.row_done(result.rows.back().trained_now, elapsed_since(row_start));
+      progress.row_done(elapsed_since(row_start));
       continue;
     }
     RowResult internal = evaluate_row(row, internal_->training.model, o_.output / "rows" / row.id);

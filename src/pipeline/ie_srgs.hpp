@@ -54,7 +54,6 @@ struct RowResult {
   double train_seconds = 0;       // the row's own HR training (internal only: the LR model's)
   double fps = 0;                 // test-view rendering at HR
   bool from_earlier_run = false;  // kept from the folder's table, not run by this command
-  bool trained_now = false;       // its HR model trained by this command, not loaded from cache
 };
 
 struct RunResult {

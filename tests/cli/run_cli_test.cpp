@@ -168,6 +168,17 @@ TEST_F(RunCli, AMissingCheckpointLeavesNoOutputFolder) {
   }
 }
 
+// The ETA is for the rows left to train: after external here, none, since ie-srgs is cached.
+TEST_F(RunCli, RowsReusedFromTheCacheAreLeftOutOfTheEta) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
+  const std::string rows = "run " + scene + " -o " + out + " --rows ";
+  ASSERT_EQ(iesrgs(rows + "ie-srgs" + kTinySchedule).status, 0);
+  const CliRun run = iesrgs(rows + "external,ie-srgs" + kTinySchedule);
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(contains(run.output, "HR rows: 1 of 2 done in ")) << run.output;
+  EXPECT_FALSE(contains(run.output, "for the rest")) << run.output;
+}
+
 TEST_F(RunCli, IeSrgsRowOffTheMaskIsLabelledByItsTexture) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
   const CliRun run =
