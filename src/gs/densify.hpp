@@ -20,11 +20,13 @@ struct ViewStatistics {
   torch::Tensor radii;
 };
 
+// Absolute: AbsGS's sums of absolute per-pixel gradients in place of the norm of their sum, as
+// gsplat's absgrad. They run larger: gsplat pairs them with a threshold near 8e-4, not 2e-4.
 enum class GradientSource { Viewspace, Absolute };
 
 struct DensifyOptions {
   double grad_threshold = 2e-4;
-  GradientSource source = GradientSource::Viewspace;  // Absolute: GOF-style absolute gradients
+  GradientSource source = GradientSource::Viewspace;
   double percent_dense = 0.01;  // clone below, split above this fraction of the extent
   double min_opacity = 0.005;
   float max_screen_size = 0;  // prune splats drawn larger (max radius, pixels); 0: off

@@ -24,7 +24,7 @@ struct TrainConfig {
   int64_t densify_from = 500, densify_until = 15000, densify_every = 100;
   int64_t opacity_reset_every = 3000;
   double grad_threshold = 2e-4;
-  bool absolute_gradients = false;
+  bool absolute_gradients = false;  // AbsGS's; wants a larger grad_threshold (gs/densify.hpp)
   double percent_dense = 0.01;
   double min_opacity = 0.005;
   // Large-splat pruning after the first opacity reset; 0: off. 3DGS and Mip-Splatting pass a
