@@ -21,16 +21,18 @@ std::string describe(const Intrinsics& k) {
 }
 
 // The pre-downscaled copy, if present: the image's top folder below the scene root gets "_<k>"
-// (COLMAP / nerfstudio convention: images/cam0/a.png -> images_2/cam0/a.png).
-fs::path downscaled_copy(const fs::path& root, const fs::path& image_path, int downscale) {
+// (COLMAP / nerfstudio convention: images/cam0/a.png -> images_2/cam0/a.png). A scene given as
+// its transforms.json has that file's folder as its root.
+fs::path downscaled_copy(const fs::path& scene_root, const fs::path& image_path, int downscale) {
   if (downscale <= 1) return {};
+  std::error_code ec;
+  const fs::path root = fs::is_regular_file(scene_root, ec) ? scene_root.parent_path() : scene_root;
   const fs::path relative = image_path.lexically_relative(root);
   if (relative.empty() || *relative.begin() == ".." ||
       std::next(relative.begin()) == relative.end())
     return {};  // not inside a folder of the scene
   fs::path candidate = root / (relative.begin()->string() + "_" + std::to_string(downscale));
   for (auto part = std::next(relative.begin()); part != relative.end(); ++part) candidate /= *part;
-  std::error_code ec;
   return fs::is_regular_file(candidate, ec) ? candidate : fs::path{};
 }
 

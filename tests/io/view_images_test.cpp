@@ -77,6 +77,18 @@ TEST(ViewImages, FindsThePreDownscaledCopyOfANestedImage) {
   EXPECT_FLOAT_EQ(images.rgb(camera)->at(1, 1, 1), 1.f);
 }
 
+TEST(ViewImages, FindsThePreDownscaledCopyOfASceneGivenAsItsJsonFile) {
+  SceneFixture f;
+  Camera camera = f.add("a.png", solid(8, 8, {255, 0, 0}));
+  write_png(f.dir / "images_2" / "a.png", solid(4, 4, {0, 255, 0}));
+  write_file_atomically(f.dir / "transforms.json", "{}");
+  f.scene.root = f.dir / "transforms.json";
+  f.scene.downscale = 2;
+  camera.intrinsics = camera.stored.scaled(0.5);
+  ViewImages images(f.scene, f.options);
+  EXPECT_FLOAT_EQ(images.rgb(camera)->at(1, 1, 1), 1.f);
+}
+
 TEST(ViewImages, ResizesWhenNoDownscaledCopyExists) {
   SceneFixture f;
   Camera camera = f.add("a.png", solid(8, 6, {10, 200, 30}));
