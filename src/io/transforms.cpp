@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <optional>
 #include <utility>
 
@@ -155,11 +156,27 @@ void require_images_exist(const std::vector<Camera>& cameras, const fs::path& js
   }
 }
 
-// Blender frames name images without their ".png" extension.
-fs::path blender_image_path(const fs::path& dir, const std::string& file_path) {
-  fs::path path = dir / file_path;
-  if (!path.has_extension()) path += ".png";
-  return path.lexically_normal();
+// The image a frame names: the file as written when it exists, else with Windows separators
+// made '/', else with the first of `extensions` that gives a file appended. Blender frames leave
+// ".png" out (3DGS always appends it, even to "r_0.001"); instant-ngp tries common image
+// extensions. When none exists: the path as written, with the first extension appended if it has
+// none, for the error to name.
+fs::path frame_image_path(const fs::path& dir, const std::string& file_path,
+                          std::initializer_list<const char*> extensions) {
+  std::error_code ec;
+  const fs::path written = (dir / file_path).lexically_normal();
+  if (fs::is_regular_file(written, ec)) return written;
+  std::string portable = file_path;
+  std::replace(portable.begin(), portable.end(), '\\', '/');
+  const fs::path path = (dir / portable).lexically_normal();
+  if (fs::is_regular_file(path, ec)) return path;
+  for (const char* extension : extensions) {
+    fs::path candidate = path;
+    if (fs::is_regular_file(candidate += extension, ec)) return candidate;
+  }
+  fs::path missing = written;
+  if (!missing.has_extension() && extensions.size() > 0) missing += *extensions.begin();
+  return missing;
 }
 
 // A frame's keys override the scene-wide ones: nerfstudio and instant-ngp allow per-frame
@@ -227,6 +244,13 @@ Intrinsics nerfstudio_intrinsics(const FrameKeys& keys, const fs::path& image_pa
 }
 
 Distortion nerfstudio_distortion(const FrameKeys& keys) {
+  // instant-ngp flags a fisheye lens beside its k1..k4 instead of naming a camera model: read
+  // as OPENCV, its images would be undistorted wrongly without a word.
+  if (const json* fisheye = keys.find("is_fisheye"); fisheye && *fisheye == true)
+    keys.where("is_fisheye")
+        .fail(
+            "fisheye lenses (\"is_fisheye\": true) are not supported (supported: PINHOLE, "
+            "OPENCV)");
   const bool has_coefficients = keys.find("k1") || keys.find("k2") || keys.find("p1") ||
                                 keys.find("p2") || keys.find("k3") || keys.find("k4");
   const std::string model =
@@ -252,7 +276,8 @@ std::vector<std::pair<std::string, Camera>> nerfstudio_cameras(
     const FrameKeys keys(document, frames[i], json_path, static_cast<int>(i));
     std::string file_path = read_file_path(frames[i], keys.frame());
     Camera camera = posed_camera(frames[i], keys.frame(),
-                                 (json_path.parent_path() / file_path).lexically_normal());
+                                 frame_image_path(json_path.parent_path(), file_path,
+                                                  {".png", ".jpg", ".jpeg", ".PNG", ".JPG"}));
     camera.stored = camera.intrinsics = nerfstudio_intrinsics(keys, camera.image_path, read_header);
     camera.distortion = nerfstudio_distortion(keys);
     cameras.emplace_back(std::move(file_path), std::move(camera));
@@ -272,7 +297,7 @@ std::vector<Camera> parse_blender_transforms(const std::string& text, const fs::
   for (size_t i = 0; i < frames.size(); ++i) {
     const Where where{json_path, static_cast<int>(i)};
     const fs::path image_path =
-        blender_image_path(json_path.parent_path(), read_file_path(frames[i], where));
+        frame_image_path(json_path.parent_path(), read_file_path(frames[i], where), {".png"});
     cameras.push_back(posed_camera(frames[i], where, image_path));
     cameras.back().split = split;
   }

@@ -89,14 +89,18 @@ TEST(BlenderScene, WithoutTestFileHasNoTestCameras) {
   TempDir dir;
   write_png_file(dir / "train" / "r_0.png", 20, 10);
   write_png_file(dir / "train" / "r_1.jpeg.png", 20, 10);
-  const json document = {{"camera_angle_x", 2 * std::atan(0.5)},
-                         {"frames", {frame("./train/r_0"), frame("./train/r_1.jpeg.png")}}};
+  write_png_file(dir / "train" / "r_2.001.png", 20, 10);
+  const json document = {
+      {"camera_angle_x", 2 * std::atan(0.5)},
+      {"frames", {frame("./train/r_0"), frame("./train/r_1.jpeg.png"), frame("./train/r_2.001")}}};
   write_text(dir / "transforms_train.json", document.dump());
   const Scene scene = read_blender_scene(dir.path(), {});
-  ASSERT_EQ(scene.cameras.size(), 2u);
+  ASSERT_EQ(scene.cameras.size(), 3u);
   EXPECT_TRUE(scene.split(Split::Test).empty());
   EXPECT_EQ(scene.cameras[0].image_path, dir / "train" / "r_0.png");  // ".png" appended
   EXPECT_EQ(scene.cameras[1].image_path, dir / "train" / "r_1.jpeg.png");
+  // As 3DGS reads it: ".png" appended to what only looks like an extension.
+  EXPECT_EQ(scene.cameras[2].image_path, dir / "train" / "r_2.001.png");
   const Intrinsics& k = scene.cameras[0].stored;
   EXPECT_EQ(k.width, 20);
   EXPECT_EQ(k.height, 10);
@@ -221,12 +225,27 @@ TEST(NerfstudioScene, ReadsImageSizeFromTheFilesWhenAbsent) {
   EXPECT_EQ(scene.cameras[0].stored.height, 6);
 }
 
+// As instant-ngp reads them: a file_path without its extension, or with Windows separators.
+TEST(NerfstudioScene, FramePathsWithoutExtensionOrWithBackslashesAreFound) {
+  TempDir dir;
+  write_png_file(dir / "images" / "a.jpg", 8, 6);
+  write_png_file(dir / "images" / "b.png", 8, 6);
+  json document = nerfstudio_document();
+  document["frames"] = {frame("images/a"), frame("images\\b.png")};
+  write_text(dir / "transforms.json", document.dump());
+  const Scene scene = read_nerfstudio_scene(dir / "transforms.json", {});
+  ASSERT_EQ(scene.cameras.size(), 2u);
+  EXPECT_EQ(scene.cameras[0].image_path, dir / "images" / "a.jpg");
+  EXPECT_EQ(scene.cameras[1].image_path, dir / "images" / "b.png");
+}
+
 TEST(NerfstudioScene, CameraModels) {
   json document = nerfstudio_document();
   EXPECT_FALSE(parse_in_memory(document).cameras[0].distortion.any());
 
   document["k1"] = 0.1;  // no camera_model with coefficients: OPENCV
   document["p2"] = -0.01;
+  document["is_fisheye"] = false;  // as instant-ngp's colmap2nerf writes it
   Distortion d = parse_in_memory(document).cameras[0].distortion;
   EXPECT_DOUBLE_EQ(d.k1, 0.1);
   EXPECT_DOUBLE_EQ(d.k2, 0);
@@ -342,6 +361,12 @@ TEST(NerfstudioScene, BadInputGivesOneLineErrorNamingFileAndProblem) {
       {"fisheye",
        edited([](json& d) { d["camera_model"] = "OPENCV_FISHEYE"; }),
        {"unsupported \"camera_model\" \"OPENCV_FISHEYE\""}},
+      {"instant-ngp fisheye",
+       edited([](json& d) {
+         d["k1"] = 0.05;
+         d["is_fisheye"] = true;
+       }),
+       {"\"is_fisheye\": true) are not supported"}},
       {"model not string",
        edited([](json& d) { d["frames"][0]["camera_model"] = 1; }),
        {"frame 0: \"camera_model\" must be a string"}},
