@@ -190,8 +190,9 @@ class FrameKeys {
     const json* value = iesrgs::find(frame_, key);
     return value ? value : iesrgs::find(scene_, key);
   }
+  bool in_frame(const char* key) const { return frame_.contains(key); }
   // Messages about `key` name the frame only when the value came from it.
-  Where where(const char* key) const { return {json_path_, frame_.contains(key) ? index_ : -1}; }
+  Where where(const char* key) const { return {json_path_, in_frame(key) ? index_ : -1}; }
   Where frame() const { return {json_path_, index_}; }
 
   std::optional<double> number(const char* key) const {
@@ -213,10 +214,12 @@ class FrameKeys {
   int index_;
 };
 
-// `focal_key` (in pixels) or else `angle_key` (the field of view across `side` pixels).
+// `focal_key` (in pixels) or else `angle_key` (the field of view across `side` pixels). A frame's
+// own angle overrides the scene's focal, as in instant-ngp.
 std::optional<double> read_focal(const FrameKeys& keys, const char* focal_key,
                                  const char* angle_key, int side) {
-  if (const std::optional<double> focal = keys.number(focal_key)) {
+  const bool frame_angle = keys.in_frame(angle_key) && !keys.in_frame(focal_key);
+  if (const std::optional<double> focal = frame_angle ? std::nullopt : keys.number(focal_key)) {
     if (!(*focal > 0))
       keys.where(focal_key).fail(fmt::format("\"{}\" must be positive", focal_key));
     return focal;

@@ -199,6 +199,10 @@ TEST(NerfstudioScene, FrameKeysOverrideSceneIntrinsics) {
   EXPECT_DOUBLE_EQ(overridden.cx, 3.5);
   EXPECT_DOUBLE_EQ(overridden.cy, 3);  // absent: the image center
   EXPECT_DOUBLE_EQ(scene.cameras[0].stored.fx, 10);
+
+  // A frame's field of view overrides the scene's focal in pixels too.
+  document["frames"][1]["camera_angle_x"] = 2 * std::atan(0.5);  // 8 pixels wide: fx = 8
+  EXPECT_NEAR(parse_in_memory(document).cameras[0].stored.fx, 8, 1e-9);
 }
 
 TEST(NerfstudioScene, FieldOfViewAndImageHeaderFillMissingIntrinsics) {
