@@ -314,11 +314,15 @@ loss::FusionWeights Pipeline::row_weights(const RowSpec& row) const {
   return weights;
 }
 
-// The ie-srgs row takes --texture: off the mask, its label says what supervised it instead.
+// The ie-srgs row takes --texture: off the mask, its label says what supervised it instead. The
+// row that adds E_depth says when there is none, since it then trains as external only.
 std::string Pipeline::row_label(const RowSpec& row) const {
   const TextureGuidance texture = row_weights(row).texture;
-  if (texture == row.texture) return row.label;
-  return fmt::format("IE-SRGS, {} texture (no mask)", loss::texture_guidance_name(texture));
+  if (texture != row.texture)
+    return fmt::format("IE-SRGS, {} texture (no mask)", loss::texture_guidance_name(texture));
+  if (std::string(row.id) == "external-depth" && o_.external.depth_model == "none")
+    return fmt::format("{} (off: no --depth-model)", row.label);
+  return row.label;
 }
 
 FusionSetup Pipeline::fusion_setup(const RowSpec& row, const loss::FusionWeights& weights) const {

@@ -179,15 +179,18 @@ TEST_F(RunCli, RowsReusedFromTheCacheAreLeftOutOfTheEta) {
   EXPECT_FALSE(contains(run.output, "for the rest")) << run.output;
 }
 
-TEST_F(RunCli, IeSrgsRowOffTheMaskIsLabelledByItsTexture) {
+// Labels say what trained a row when the options changed it: the ie-srgs row off the mask, the
+// E_depth row without a depth model (so trained as external only).
+TEST_F(RunCli, RowLabelsSayWhatTrainedThem) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
-  const CliRun run =
-      iesrgs("run " + scene + " -o " + out + " --rows ie-srgs --texture external" + kTinySchedule);
+  const CliRun run = iesrgs("run " + scene + " -o " + out +
+                            " --rows ie-srgs,external-depth --texture external" + kTinySchedule);
   ASSERT_EQ(run.status, 0) << run.output;
-  EXPECT_TRUE(contains(run.output, "== row 1/1 ie-srgs: IE-SRGS, external texture (no mask) =="))
+  EXPECT_TRUE(contains(run.output, "== row 2/2 ie-srgs: IE-SRGS, external texture (no mask) =="))
       << run.output;
   const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
-  EXPECT_EQ(results["rows"][0]["label"], "IE-SRGS, external texture (no mask)");
+  EXPECT_EQ(results["rows"][0]["label"], "+ E_depth (off: no --depth-model)");
+  EXPECT_EQ(results["rows"][1]["label"], "IE-SRGS, external texture (no mask)");
 }
 
 TEST_F(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
