@@ -47,10 +47,16 @@ std::string stage_identity(const ExternalOptions& o) {
 std::string view_fingerprint(const std::string& stage, const ViewImages& images,
                              const Camera& camera) {
   const Scene& scene = images.scene();
-  const std::string text =
+  std::string text =
       fmt::format("{} | {} {}x{} /{} bg {},{},{}", stage, images.source_digest(camera),
                   camera.intrinsics.width, camera.intrinsics.height, scene.downscale,
                   scene.background[0], scene.background[1], scene.background[2]);
+  // A distorted view is undistorted before it is upscaled: its lens shapes the input too.
+  if (const Distortion& d = camera.distortion; d.any()) {
+    const Intrinsics& k = camera.intrinsics;
+    text += fmt::format(" | lens {} {} {} {} {} {} {} {}", k.fx, k.fy, k.cx, k.cy, d.k1, d.k2, d.p1,
+                        d.p2);
+  }
   return bytes_digest(text);
 }
 

@@ -59,6 +59,19 @@ TEST(ExternalStage, SuperResolvesEveryTrainingViewOnceAndRecomputesOnChange) {
   EXPECT_EQ(read_file(views[1].image), good);
   EXPECT_EQ(read_image_header(views[2].image).width, 32);
 
+  // A new lens for the second view undistorts its image differently: computed again.
+  Scene lensed = scene;
+  for (Camera& camera : lensed.cameras)
+    if (camera.split == Split::Train && camera.name == scene.split(Split::Train)[1]->name)
+      camera.distortion.k1 = 0.05;
+  ViewImageOptions lens_options;
+  lens_options.undistort_cache_dir = dir / "undistorted";
+  ViewImages lensed_images(lensed, lens_options);
+  const auto undistorted_before = std::filesystem::last_write_time(views[1].image);
+  run_external_stage(lensed, lensed_images, options, dir / "ext");
+  EXPECT_NE(std::filesystem::last_write_time(views[1].image), undistorted_before);
+  EXPECT_NE(read_file(views[1].image), good);
+
   options.scale = 4;  // a different stage: every view again
   run_external_stage(scene, images, options, dir / "ext");
   EXPECT_EQ(read_image_header(views[0].image).width, 64);
