@@ -23,7 +23,7 @@ void run_external(const ExternalArgs& args) {
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   ViewImages images(scene);
   pipeline::ExternalOptions options = args.options;
-  pipeline::resolve_sr_model(options);
+  pipeline::resolve_sr_model(options, true);
   const FolderLock lock(args.output);
   pipeline::run_external_stage(scene, images, options, args.output);
 }

@@ -62,10 +62,10 @@ std::string view_fingerprint(const std::string& stage, const ViewImages& images,
 
 }  // namespace
 
-void resolve_sr_model(ExternalOptions& options) {
+void resolve_sr_model(ExternalOptions& options, bool announce) {
   if (options.sr_model != "auto") return;
   options.sr_model = priors::sr::auto_sr_model(options.scale);
-  fmt::print("SR prior: {} (--sr-model auto)\n", options.sr_model);
+  if (announce) fmt::print("SR prior: {} (--sr-model auto)\n", options.sr_model);
 }
 
 std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& images,

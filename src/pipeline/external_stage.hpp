@@ -29,8 +29,8 @@ struct ExternalView {
 };
 
 // Replaces "auto" by the best SR model at hand for the scale (priors::sr::auto_sr_model), saying
-// which.
-void resolve_sr_model(ExternalOptions& options);
+// which when `announce`.
+void resolve_sr_model(ExternalOptions& options, bool announce);
 
 // Runs the stage for the training cameras of `scene` (the low-resolution input) into `dir`,
 // printing progress, and returns one entry per training view in scene order. The cache record is

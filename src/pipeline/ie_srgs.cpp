@@ -208,7 +208,8 @@ class Pipeline {
 Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(options.rows)) {
   if (o_.scale < 2) fail("--scale must be at least 2, got {}", o_.scale);
   o_.external.scale = o_.scale;
-  if (any_row(Source::SuperResolved)) resolve_sr_model(o_.external);
+  // Also when no row of this run upscales: the folder's earlier rows that did are matched by it.
+  resolve_sr_model(o_.external, any_row(Source::SuperResolved));
   SceneOptions lr_options = o_.scene_options;
   if (!o_.input_is_lr) {
     hr_scene_ = load_scene(o_.scene, o_.scene_options);
@@ -537,12 +538,14 @@ bool Pipeline::row_current(const RowSpec& row, const nlohmann::json& entry,
                            bool internal_current) const {
   if (row.source == Source::HighRes && !hr_images_) return false;
   if (row_uses_internal(row) && !internal_current) return false;
-  // The internal-only row scored the internal model of its own run, which a later run may have
-  // trained again under other settings; the model's recorded training time names it.
-  if (row.source == Source::Internal)
-    return entry.value("train_seconds", -1.0) == stage_seconds(o_.output / "internal");
-  return training_stage_current(o_.output / "rows" / row.id, row_params(row, row_weights(row)),
-                                o_.fusion_config);
+  // The entry must score the model its stage holds now, which its recorded training time names:
+  // a later run may have trained the internal model again, or a row, and stopped before writing
+  // the table.
+  const bool internal = row.source == Source::Internal;
+  const fs::path dir = internal ? o_.output / "internal" : o_.output / "rows" / row.id;
+  if (entry.value("train_seconds", -1.0) != stage_seconds(dir)) return false;
+  return internal ||
+         training_stage_current(dir, row_params(row, row_weights(row)), o_.fusion_config);
 }
 
 // A rerun with fewer rows keeps the others of the folder's table, as long as their cached stage

@@ -246,6 +246,40 @@ TEST_F(RunCli, RetrainedInternalModelDropsTheEarlierInternalRow) {
   EXPECT_EQ(ids, (std::vector<std::string>{"external", "joint"}));
 }
 
+// An earlier row stays only while its stage holds the model it scored: a run that trained the
+// row again and stopped before writing the table leaves the old entry behind.
+TEST_F(RunCli, AnEarlierRowIsKeptOnlyForTheModelItScored) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
+  const std::string rows = "run " + scene + " -o " + out + " --rows ";
+  ASSERT_EQ(iesrgs(rows + "bicubic,external" + kTinySchedule).status, 0);
+  const auto results_path = dir / "run" / "results.json";
+  auto results = nlohmann::json::parse(read_file(results_path));
+  ASSERT_EQ(results["rows"][1]["row"], "external");
+  results["rows"][1]["train_seconds"] = results["rows"][1]["train_seconds"].get<double>() + 1;
+  write_file_atomically(results_path, results.dump());
+  ASSERT_EQ(iesrgs(rows + "bicubic" + kTinySchedule).status, 0);
+  results = nlohmann::json::parse(read_file(results_path));
+  ASSERT_EQ(results["rows"].size(), 1u) << results.dump();
+  EXPECT_EQ(results["rows"][0]["row"], "bicubic");
+}
+
+// With --sr-model auto, a run without super-resolved rows still names the prior its kept rows
+// were made with.
+TEST_F(RunCli, RowsOfTheAutomaticPriorAreKeptByARunWithoutThem) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
+  const std::string rows = "run " + scene + " -o " + out +
+                           " --iterations 20 --internal-iterations 20 --set random_points=1500"
+                           " --internal-set random_points=1500 --lpips none --rows ";
+  ASSERT_EQ(iesrgs(rows + "bicubic,external").status, 0);
+  const CliRun bicubic = iesrgs(rows + "bicubic");
+  ASSERT_EQ(bicubic.status, 0) << bicubic.output;
+  EXPECT_FALSE(contains(bicubic.output, "SR prior:")) << bicubic.output;
+  const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+  ASSERT_EQ(results["rows"].size(), 2u) << results.dump();
+  EXPECT_EQ(results["rows"][1]["row"], "external");
+  EXPECT_TRUE(results["rows"][1].value("from_earlier_run", false));
+}
+
 // Earlier rows scored against test views that changed since leave the table, the internal-only
 // row too, though its model learnt from the unchanged training views.
 TEST_F(RunCli, RowsScoredAgainstOtherTestViewsLeaveTheTable) {
