@@ -369,15 +369,16 @@ nlohmann::json Pipeline::row_params(const RowSpec& row, const loss::FusionWeight
                            {"dssim_weight", weights.dssim_weight},
                            {"internal_depth", weights.internal_depth},
                            {"external_depth", weights.external_depth},
-                           {"threshold", threshold_},
                            {"init", o_.init},
                            {"train_views", train_digest_},
                            {"test_views", test_digest_}};
   if (row.source == Source::SuperResolved)
     params["external"] = {{"sr_model", o_.external.sr_model},
                           {"depth_model", o_.external.depth_model}};
-  if (row.source == Source::HighRes)
-    params["hr_train_views"] = split_digest(*hr_images_, Split::Train);
+  // T shapes only the discrepancy mask; the oracle mask comes from the HR truth instead.
+  if (weights.texture == TextureGuidance::Masked && !row.oracle_mask)
+    params["threshold"] = threshold_;
+  if (RowSpec::needs_truth(row)) params["hr_train_views"] = split_digest(*hr_images_, Split::Train);
   // The stage's record holds a content fingerprint per view: it changes with any reference.
   if (row.source == Source::SuperResolved || row.source == Source::Bicubic)
     params["references"] = file_digest(
@@ -536,7 +537,7 @@ RunResult Pipeline::run() {
 
 bool Pipeline::row_current(const RowSpec& row, const nlohmann::json& entry,
                            bool internal_current) const {
-  if (row.source == Source::HighRes && !hr_images_) return false;
+  if (RowSpec::needs_truth(row) && !hr_images_) return false;
   if (row_uses_internal(row) && !internal_current) return false;
   // The entry must score the model its stage holds now, which its recorded training time names:
   // a later run may have trained the internal model again, or a row, and stopped before writing

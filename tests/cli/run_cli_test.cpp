@@ -263,6 +263,49 @@ TEST_F(RunCli, AnEarlierRowIsKeptOnlyForTheModelItScored) {
   EXPECT_EQ(results["rows"][0]["row"], "bicubic");
 }
 
+// The oracle mask comes from the HR truth: an edited HR view trains the row again, though the LR
+// input, read from pre-downscaled copies, stays the same.
+TEST_F(RunCli, AnEditedTruthRetrainsTheOracleRow) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
+  for (int i = 0; i < 4; ++i) {
+    const std::string name = "r_" + std::to_string(i) + ".png";
+    const Image8 hr = read_image8(dir / "scene/train" / name);
+    Image8 lr(8, 8, hr.channels);
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x)
+        for (int c = 0; c < hr.channels; ++c)
+          lr.data[size_t((y * 8 + x) * hr.channels + c)] =
+              hr.data[size_t((4 * y * 32 + 4 * x) * hr.channels + c)];
+    write_png(dir / "scene/train_4" / name, lr);
+  }
+  const std::string command = "run " + scene + " -o " + out + " --rows mask-oracle" + kTinySchedule;
+  ASSERT_EQ(iesrgs(command).status, 0);
+  const auto truth = dir / "scene/train/r_1.png";
+  Image8 edited = read_image8(truth);
+  for (uint8_t& value : edited.data) value = uint8_t(255 - value);
+  write_png(truth, edited);
+  const CliRun again = iesrgs(command);
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_TRUE(contains(again.output, "external stage: 0 views computed")) << again.output;
+  EXPECT_FALSE(contains(again.output,
+                        "reusing the finished model in " + (dir / "run/rows/mask-oracle").string()))
+      << again.output;
+}
+
+// T shapes the discrepancy mask alone: another T trains the ie-srgs row again, not the others.
+TEST_F(RunCli, AnotherThresholdRetrainsOnlyTheMaskedRow) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
+  const std::string rows = "run " + scene + " -o " + out + " --rows external,ie-srgs";
+  ASSERT_EQ(iesrgs(rows + kTinySchedule).status, 0);
+  const CliRun again = iesrgs(rows + " --threshold 0.3" + kTinySchedule);
+  ASSERT_EQ(again.status, 0) << again.output;
+  const std::string rows_dir = (dir / "run" / "rows").string();
+  EXPECT_TRUE(contains(again.output, "reusing the finished model in " + rows_dir + "/external"))
+      << again.output;
+  EXPECT_FALSE(contains(again.output, "reusing the finished model in " + rows_dir + "/ie-srgs"))
+      << again.output;
+}
+
 // With --sr-model auto, a run without super-resolved rows still names the prior its kept rows
 // were made with.
 TEST_F(RunCli, RowsOfTheAutomaticPriorAreKeptByARunWithoutThem) {
