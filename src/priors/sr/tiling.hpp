@@ -12,7 +12,10 @@ struct TileOptions {
   int tile = 0;  // side of a tile in input pixels; 0 upscales the whole image at once
   // Input pixels shared by neighbouring tiles. The outer quarter of an overlap is context only
   // (weight 0), the middle half is cross-faded linearly, so tiles agree with the whole-image
-  // result wherever the network's receptive field stays within a quarter of the overlap.
+  // result wherever the network's receptive field stays within a quarter of the overlap. No
+  // network here is that local (SAFMN and IMDN normalize by whole-input statistics, SwinIR's
+  // windows shift with the tile), so tiled results differ slightly everywhere: SAFMN on a fox
+  // view of 270x480 in tiles of 256 is 58.5 dB PSNR from the whole image upscaled at once.
   int overlap = 32;
 };
 
