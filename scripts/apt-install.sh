@@ -9,7 +9,16 @@ for package in "$@"; do
 done
 ((${#missing[@]})) || exit 0
 echo "installing ${missing[*]}"
-sudo=""
-[ "$(id -u)" -eq 0 ] || sudo="sudo"
-$sudo apt-get update -qq
-DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+sudo=()
+if [ "$(id -u)" -ne 0 ]; then
+  if ! command -v sudo >/dev/null; then
+    echo "error: these Debian packages are missing: ${missing[*]}; install them as root" \
+      "(apt-get install ${missing[*]}) or install sudo, then run this again" >&2
+    exit 1
+  fi
+  sudo=(sudo)
+fi
+# Through env: sudo drops the caller's environment, and apt would then ask its questions.
+"${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+"${sudo[@]}" env DEBIAN_FRONTEND=noninteractive \
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -49,7 +49,8 @@ if [ "${1:-}" = "--quick" ]; then
   shift
 fi
 
-options=(-DIESRGS_CUDA=ON -DCMAKE_BUILD_TYPE=Release -DIESRGS_BENCH=OFF)
+# IESRGS_KERNELS_ONLY is set either way: the cache would keep a --kernels-only run's ON.
+options=(-DIESRGS_CUDA=ON -DCMAKE_BUILD_TYPE=Release -DIESRGS_BENCH=OFF -DIESRGS_KERNELS_ONLY=OFF)
 targets=(--target iesrgs_cuda_tests)
 if $kernels_only; then
   options+=(-DIESRGS_KERNELS_ONLY=ON -DIESRGS_BENCH=ON)

@@ -5,8 +5,9 @@
 # bicubic-3DGS, internal only, external only and IE-SRGS. Outputs go to demo/ (or the folder
 # given as the first argument); rerunning reuses every finished stage.
 set -euo pipefail
+out=demo  # in the repository; a folder given is taken from where the script is called
+[ -z "${1:-}" ] || out=$(realpath -m -- "$1")
 cd "$(dirname "$0")/.."
-out="${1:-demo}"
 scripts/setup.sh --cli
 build/iesrgs synth -o "$out/scene" --size 128 --views 40 --test-views 10 --seed 1
 # A short CPU schedule, and fewer random starting points than 3DGS's 100k for a scene this small.

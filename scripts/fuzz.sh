@@ -25,7 +25,8 @@ if [[ ${#names[@]} -eq 0 ]]; then
   exit 1
 fi
 
-command -v "${CXX:-clang++}" >/dev/null || "$root/scripts/apt-install.sh" clang  # with libFuzzer
+# libFuzzer's runtime is in libclang-rt-14-dev, which clang only recommends.
+[ -n "${CXX:-}" ] || "$root/scripts/apt-install.sh" clang libclang-rt-14-dev
 
 targets=()
 for name in "${names[@]}"; do targets+=("iesrgs_${name}_fuzzer"); done

@@ -6,6 +6,22 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+build_dir=build
+options=(-DCMAKE_BUILD_TYPE=Release)
+targets=()
+case "${1:-}" in
+  --asan)
+    build_dir=build-asan
+    # Line tables (-g1) are all the sanitizers' reports need; full debug information of
+    # LibTorch's templates would double the compile time. The CUDA kernels are left out: nvcc
+    # does not take these sanitizers, and compute-sanitizer checks them on a GPU machine.
+    options=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
+             -DIESRGS_SANITIZE=ON -DIESRGS_BENCH=OFF -DIESRGS_CUDA=OFF) ;;
+  --cli) targets=(--target iesrgs) ;;
+  "") ;;
+  *) echo "error: unknown option '$1' (setup.sh takes --cli or --asan, or nothing)" >&2; exit 2 ;;
+esac
+
 PACKAGES=(
   build-essential cmake pkg-config
   libtorch-dev          # tensors, autograd, Adam, .pth checkpoints
@@ -29,19 +45,6 @@ if [ ! -f "$packages/esrgan-thick/models/x4/model.json" ] ||
     @upscalerjs/esrgan-thick@1.0.0 @upscalerjs/esrgan-slim@1.0.0
 fi
 
-build_dir=build
-options=(-DCMAKE_BUILD_TYPE=Release)
-targets=()
-case "${1:-}" in
-  --asan)
-    build_dir=build-asan
-    # Line tables (-g1) are all the sanitizers' reports need; full debug information of
-    # LibTorch's templates would double the compile time. The CUDA kernels are left out: nvcc
-    # does not take these sanitizers, and compute-sanitizer checks them on a GPU machine.
-    options=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
-             -DIESRGS_SANITIZE=ON -DIESRGS_BENCH=OFF -DIESRGS_CUDA=OFF) ;;
-  --cli) targets=(--target iesrgs) ;;
-esac
 cmake -S . -B "$build_dir" "${options[@]}" >/dev/null
 cmake --build "$build_dir" -j "$(nproc)" "${targets[@]}"
 echo "setup: built $build_dir/iesrgs"
