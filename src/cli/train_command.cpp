@@ -31,20 +31,13 @@ struct TrainArgs {
   std::vector<std::string> assignments;
   std::string init_ply;
   bool resume = false;
+  bool run_options_given = false;  // any of those that make up the config
   std::string device = "auto";
 };
 
-train::TrainConfig resolve_config(const TrainArgs& args, const std::filesystem::path& saved) {
-  train::TrainConfig config;
-  if (args.resume) {
-    // The stored config is the run's identity; changing it midway would not resume the run.
-    if (!std::filesystem::exists(saved))
-      fail_file(saved, "missing: --resume needs the output folder of an earlier run");
-    train::apply_json(config, read_json_file(saved), saved.string());
-    spdlog::info("resuming with the config saved in {}", saved.string());
-    return config;
-  }
-  config = train::make_preset(args.preset, args.iterations);
+// The config a new run with these options trains with.
+train::TrainConfig requested_config(const TrainArgs& args) {
+  train::TrainConfig config = train::make_preset(args.preset, args.iterations);
   if (!args.config_file.empty())
     train::apply_json(config, read_json_file(args.config_file), args.config_file);
   if (args.views_per_iteration > 0) config.views_per_iteration = args.views_per_iteration;
@@ -55,20 +48,35 @@ train::TrainConfig resolve_config(const TrainArgs& args, const std::filesystem::
   return config;
 }
 
-// The saved config is the run's identity: an option that would change it cannot take effect.
-void refuse_changes_on_resume(const std::vector<const CLI::Option*>& run_options) {
-  for (const CLI::Option* option : run_options)
-    if (option->count() > 0)
-      fail(
-          "{} cannot change a resumed run: --resume continues with the config saved in the output "
-          "folder (train into a new folder for other settings)",
-          option->get_name());
+// The stored config is the run's identity: --resume continues with it. Options given beside it
+// must make the same config (the run's own command again), or none be given.
+train::TrainConfig resumed_config(const TrainArgs& args, const std::filesystem::path& saved) {
+  if (!std::filesystem::exists(saved))
+    fail_file(saved, "missing: --resume needs the output folder of an earlier run");
+  train::TrainConfig config;
+  train::apply_json(config, read_json_file(saved), saved.string());
+  spdlog::info("resuming with the config saved in {}", saved.string());
+  if (!args.run_options_given) return config;
+  const nlohmann::json kept = train::to_json(config),
+                       asked = train::to_json(requested_config(args));
+  std::vector<std::string> changes;
+  for (const auto& item : kept.items())
+    if (asked[item.key()] != item.value())
+      changes.push_back(fmt::format("{} {} instead of {}", item.key(), asked[item.key()].dump(),
+                                    item.value().dump()));
+  if (!changes.empty())
+    fail_file(saved, fmt::format(
+                         "--resume continues this run, and the options given would change it ({}); "
+                         "give the run's own options or none, or train into a new folder",
+                         fmt::join(changes, ", ")));
+  return config;
 }
 
 void run_train(const TrainArgs& args) {
   use_device(args.device);
   const std::filesystem::path out = args.output;
-  const train::TrainConfig config = resolve_config(args, out / "config.json");
+  const train::TrainConfig config =
+      args.resume ? resumed_config(args, out / "config.json") : requested_config(args);
 
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   ViewImages images(scene);
@@ -87,8 +95,10 @@ void run_train(const TrainArgs& args) {
                                                 train::initial_model(scene, config, args.init_ply));
   // Only now that the scene and the starting model have loaded: a folder holding a config but no
   // checkpoint would make --resume fail on that instead of the real problem.
-  if (!args.resume)
+  if (!args.resume) {
+    train::remove_earlier_run(out);
     write_file_atomically(out / "config.json", train::to_json(config).dump(2) + "\n");
+  }
   const train::TrainSummary summary = trainer.run();
   if (summary.interrupted) throw Interrupted("continue with the same command and --resume");
   train::write_point_clouds(out, trainer.model());
@@ -137,12 +147,14 @@ void add_train_command(CLI::App& app) {
   defines_run(command->add_option(
       "--set", args->assignments,
       "Override one training parameter, key=value (repeatable; see config.json)"));
-  defines_run(command->add_option("--init-ply", args->init_ply,
-                                  "Start from this 3DGS .ply, .spz or .splat instead"));
-  command->add_flag("--resume", args->resume, "Continue the run in --output from its checkpoint");
+  // Not part of the config: a resumed run starts from its checkpoint whatever it says.
+  command->add_option("--init-ply", args->init_ply,
+                      "Start from this 3DGS .ply, .spz or .splat instead");
+  command->add_flag("--resume", args->resume,
+                    "Continue the run in --output from its checkpoint, with its saved config");
   add_device_option(*command, args->device);
   command->callback([args, run_options] {
-    if (args->resume) refuse_changes_on_resume(run_options);
+    for (const CLI::Option* option : run_options) args->run_options_given |= option->count() > 0;
     run_train(*args);
   });
 }

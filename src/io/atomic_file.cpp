@@ -2,8 +2,11 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 
 #include "core/error.hpp"
@@ -12,13 +15,33 @@ namespace iesrgs {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+constexpr std::string_view kTemporaryMark = ".tmp-";
+
+fs::path temporary_path(const fs::path& path) {
+  return path.string() + std::string(kTemporaryMark) + std::to_string(::getpid());
+}
+
+// "<name>.tmp-<digits>", as temporary_path names them.
+bool is_temporary(const fs::path& path) {
+  const std::string name = path.filename().string();
+  const size_t mark = name.rfind(kTemporaryMark);
+  if (mark == std::string::npos || mark == 0) return false;
+  const size_t digits = mark + kTemporaryMark.size();
+  return digits < name.size() && std::all_of(name.begin() + std::ptrdiff_t(digits), name.end(),
+                                             [](unsigned char c) { return std::isdigit(c); });
+}
+
+}  // namespace
+
 void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write) {
   std::error_code ec;
   if (path.has_parent_path()) {
     fs::create_directories(path.parent_path(), ec);
     if (ec) fail_file(path.parent_path(), "cannot create directory: " + ec.message());
   }
-  const fs::path tmp = path.string() + ".tmp-" + std::to_string(::getpid());
+  const fs::path tmp = temporary_path(path);
   try {
     write(tmp);
     fs::rename(tmp, path, ec);
@@ -26,6 +49,15 @@ void write_atomically(const fs::path& path, const std::function<void(const fs::p
   } catch (...) {
     fs::remove(tmp, ec);
     throw;
+  }
+}
+
+void remove_stale_temporaries(const fs::path& folder) {
+  std::error_code walk;
+  for (fs::recursive_directory_iterator it(folder, walk), end; !walk && it != end;
+       it.increment(walk)) {
+    std::error_code ec;  // an entry that cannot be checked or removed is left alone
+    if (it->is_regular_file(ec) && is_temporary(it->path())) fs::remove(it->path(), ec);
   }
 }
 

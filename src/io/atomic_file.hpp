@@ -15,6 +15,11 @@ void write_atomically(const std::filesystem::path& path,
 // Atomic text / binary file writes.
 void write_file_atomically(const std::filesystem::path& path, const std::string& bytes);
 
+// Removes the temporaries that processes killed mid-write (a second Ctrl-C, kill -9, the OOM
+// killer) left anywhere below `folder`. Only for a folder this process holds locked, where no
+// other write can be under way.
+void remove_stale_temporaries(const std::filesystem::path& folder);
+
 // Whole file into memory; throws Error naming the file when it cannot be read.
 std::string read_file(const std::filesystem::path& path);
 

@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 
 namespace iesrgs {
 
@@ -26,7 +27,10 @@ FolderLock::FolderLock(const fs::path& folder) {
   fd_ = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0)
     fail_file(folder, std::string("cannot open the output folder (") + std::strerror(errno) + ")");
-  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
+  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) {
+    remove_stale_temporaries(folder);
+    return;
+  }
   const int error = errno;
   if (error != EWOULDBLOCK) return;  // no locks on this file system
   ::close(fd_);

@@ -64,10 +64,8 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   const fs::path checkpoint = train::checkpoint_path(dir);
   const bool resumable =
       stage_json(dir).value("params", nlohmann::json()) == identity && fs::exists(checkpoint);
-  if (!resumable) {  // an older run's checkpoint would be resumed by the next identical run
-    fs::remove(dir / "train_log.csv");
-    fs::remove(checkpoint);
-  }
+  // An older run's checkpoint would be resumed by the next identical run.
+  if (!resumable) train::remove_earlier_run(dir);
   record_stage(dir, identity, false, 0);
   if (resumable) fmt::print("{}: resuming from {}\n", name, checkpoint.string());
   train::Trainer trainer = resumable ? train::Trainer::resumed(config, std::move(setup))

@@ -4,28 +4,53 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 
 namespace iesrgs::train {
 
 namespace {
 constexpr double kPrintSeconds = 2.0;
 constexpr double kLossSmoothing = 0.9;  // exponential moving average, as 3DGS's progress bar
+constexpr const char* kHeader = "iteration,loss,gaussians,elapsed_seconds,test_psnr\n";
+
+// The log of a run resumed after `last_iteration`: its header and the complete rows up to that
+// iteration.
+std::string log_until(const std::filesystem::path& csv, int64_t last_iteration) {
+  std::string kept = kHeader;
+  std::ifstream in(csv);
+  std::string row;
+  std::getline(in, row);  // the header
+  while (std::getline(in, row)) {
+    if (in.eof()) break;  // no newline: cut off by a killed process
+    char* end = nullptr;
+    const long long iteration = std::strtoll(row.c_str(), &end, 10);
+    if (end == row.c_str() || *end != ',' || iteration > last_iteration) break;
+    kept += row + '\n';
+  }
+  return kept;
+}
 }  // namespace
 
 ProgressLog::ProgressLog(const std::filesystem::path& csv, int64_t first_iteration,
-                         int64_t total_iterations)
+                         int64_t total_iterations, double seconds_before)
     : first_iteration_(first_iteration),
       total_iterations_(total_iterations),
+      seconds_before_(seconds_before),
       start_(Clock::now()),
       last_print_(start_),
       last_print_iteration_(first_iteration) {
-  const bool fresh = !std::filesystem::exists(csv);
   if (!csv.parent_path().empty()) std::filesystem::create_directories(csv.parent_path());
+  write_file_atomically(csv, first_iteration > 0 ? log_until(csv, first_iteration) : kHeader);
   csv_.open(csv, std::ios::app);
   if (!csv_) fail_file(csv, "cannot be opened for writing");
-  if (fresh) csv_ << "iteration,loss,gaussians,elapsed_seconds,test_psnr\n";
+}
+
+void ProgressLog::flush() {
+  csv_.flush();
 }
 
 void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
@@ -35,7 +60,7 @@ void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
                        : kLossSmoothing * smoothed_loss_ + (1 - kLossSmoothing) * loss;
   const Clock::time_point now = Clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
-  csv_ << iteration << ',' << loss << ',' << gaussians << ',' << elapsed << ',';
+  csv_ << iteration << ',' << loss << ',' << gaussians << ',' << seconds_before_ + elapsed << ',';
   if (test_psnr) csv_ << *test_psnr;
   csv_ << '\n';
   const double since_print = std::chrono::duration<double>(now - last_print_).count();

@@ -12,17 +12,24 @@ namespace iesrgs::train {
 
 class ProgressLog {
  public:
-  // Appends to `csv` (writing the header when the file is new): a resumed run continues its log.
-  ProgressLog(const std::filesystem::path& csv, int64_t first_iteration, int64_t total_iterations);
+  // Starts `csv` afresh, or, for a run resumed after `first_iteration` that had trained for
+  // `seconds_before`, continues it from that iteration's row: rows logged after the checkpoint,
+  // or cut off by a killed process, are dropped first.
+  ProgressLog(const std::filesystem::path& csv, int64_t first_iteration, int64_t total_iterations,
+              double seconds_before);
 
   // Prints when `force`, when a test PSNR came in, or when enough time has passed.
   void record(int64_t iteration, double loss, int64_t gaussians, std::optional<double> test_psnr,
               bool force);
 
+  // Writes the rows recorded so far: a checkpoint's iteration is then always in the file.
+  void flush();
+
  private:
   using Clock = std::chrono::steady_clock;
   std::ofstream csv_;
   int64_t first_iteration_, total_iterations_;
+  double seconds_before_;
   Clock::time_point start_, last_print_;
   int64_t last_print_iteration_;
   double smoothed_loss_ = 0;

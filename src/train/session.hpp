@@ -44,4 +44,9 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
 // do not know it), both written atomically.
 void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianModel& model);
 
+// Removes what an earlier training left in `dir` (checkpoint, log, point clouds, summary), before
+// a new run there: --resume would otherwise continue the earlier checkpoint under the new
+// config, and a render draw the earlier model.
+void remove_earlier_run(const std::filesystem::path& dir);
+
 }  // namespace iesrgs::train

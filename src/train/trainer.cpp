@@ -1,6 +1,7 @@
 #include "train/trainer.hpp"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
 
@@ -32,22 +33,28 @@ namespace {
 
 std::atomic<bool> interrupt_requested{false};
 
-extern "C" void request_interrupt(int) {
+extern "C" void request_interrupt(int signal) {
   interrupt_requested = true;
-  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C stops at once
+  std::signal(signal, SIG_DFL);  // a second Ctrl-C stops at once
 }
 
-// SIGINT asks the loop to checkpoint and return, only while a run is in progress.
+// SIGINT (Ctrl-C) and SIGTERM (kill, timeout, docker stop) ask the loop to checkpoint and
+// return, only while a run is in progress.
 class InterruptScope {
  public:
   InterruptScope() {
     interrupt_requested = false;
-    previous_ = std::signal(SIGINT, request_interrupt);
+    previous_int_ = std::signal(SIGINT, request_interrupt);
+    previous_term_ = std::signal(SIGTERM, request_interrupt);
   }
-  ~InterruptScope() { std::signal(SIGINT, previous_); }
+  ~InterruptScope() {
+    std::signal(SIGINT, previous_int_);
+    std::signal(SIGTERM, previous_term_);
+  }
 
  private:
-  void (*previous_)(int);
+  void (*previous_int_)(int);
+  void (*previous_term_)(int);
 };
 
 torch::Tensor bytes_tensor(const std::string& bytes) {
@@ -137,8 +144,13 @@ void Trainer::save_checkpoint() {
                            {"torch_rng", torch_rng},
                            {"seconds", torch::tensor(training_seconds(), torch::kFloat64)},
                            {"loss", torch::tensor(last_loss_, torch::kFloat64)},
-                           {"test_psnr", torch::tensor(last_test_psnr_, torch::kFloat64)}});
+                           {"test_psnr", torch::tensor(last_test_psnr_, torch::kFloat64)},
+                           {"background", background_tensor()}});
   checkpoint_iteration_ = iteration_;
+}
+
+torch::Tensor Trainer::background_tensor() const {
+  return torch::tensor(std::vector<float>(setup_.background.begin(), setup_.background.end()));
 }
 
 Trainer Trainer::resumed(const TrainConfig& config, TrainerSetup setup) {
@@ -155,7 +167,8 @@ void Trainer::load_checkpoint() {
     fail_file(path, "no checkpoint to resume from (train without --resume first)");
   require_same_cameras();  // before reading a checkpoint that may not fit these views
   gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}},
-                              {"seconds", {}},   {"loss", {}},     {"test_psnr", {}}};
+                              {"seconds", {}},   {"loss", {}},     {"test_psnr", {}},
+                              {"background", {}}};
   gs::load_training_state(path, model_, *optimizer_, stats_, &extras);  // onto the CPU
   place_on(model_, device_);
   optimizer_->to(device_);
@@ -163,6 +176,13 @@ void Trainer::load_checkpoint() {
   for (const char* required : {"iteration", "view_rng", "torch_rng"})
     if (!extras[required].defined())
       fail_file(path, fmt::format("not a training checkpoint of iesrgs train (no {})", required));
+  // The training images are composited over it: another one would change what the run learns.
+  if (extras["background"].defined() && !extras["background"].equal(background_tensor()))
+    fail_file(path, fmt::format("the run trained over the background {}, not {}: resume with the "
+                                "same --background",
+                                fmt::join(extras["background"].data_ptr<float>(),
+                                          extras["background"].data_ptr<float>() + 3, ","),
+                                fmt::join(setup_.background, ",")));
   iteration_ = extras["iteration"].item<int64_t>();
   // Checkpoints of older versions lack these.
   const auto stored = [&](const char* name) {
@@ -314,7 +334,8 @@ double Trainer::report_test_psnr() {
 TrainSummary Trainer::run() {
   InterruptScope interrupt_scope;
   TrainSummary summary;
-  ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations);
+  ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations,
+                  seconds_before_);
   write_cameras_json(cameras_path(), train_cameras_);
   run_start_ = std::chrono::steady_clock::now();
   while (iteration_ < config_.iterations) {
@@ -336,8 +357,10 @@ TrainSummary Trainer::run() {
     log.record(iteration_, last_loss_, model_.size(), test_psnr, last);
     const bool interrupted = interrupt_requested.load();
     if (last || interrupted ||
-        (config_.checkpoint_every > 0 && iteration_ % config_.checkpoint_every == 0))
+        (config_.checkpoint_every > 0 && iteration_ % config_.checkpoint_every == 0)) {
+      log.flush();  // first: a resume keeps the rows up to its checkpoint and drops the rest
       save_checkpoint();
+    }
     if (interrupted) {
       fmt::print("interrupted: checkpoint of iteration {} saved to {}\n", iteration_,
                  checkpoint_path().string());

@@ -91,7 +91,8 @@ class Trainer {
   // The training cameras as 3DGS saves them for viewers; also what --resume compares against.
   std::filesystem::path cameras_path() const { return setup_.output_dir / "cameras.json"; }
   void require_same_cameras() const;  // as cameras_path() holds them
-  double step(int64_t iteration);     // one optimizer step; returns the loss
+  torch::Tensor background_tensor() const;
+  double step(int64_t iteration);  // one optimizer step; returns the loss
   std::vector<int> pick_views();
   void densify(int64_t iteration);
   int64_t densify_cap() const;  // config.max_gaussians, or fewer when memory runs short

@@ -135,18 +135,31 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   EXPECT_GT(again["test_psnr"].get<double>(), 0.0);
   EXPECT_GT(again["iterations_per_second"].get<double>(), 0.0);
 
-  const CliRun longer = iesrgs(train + " --resume --iterations 20");
+  // The run's own command again, as the interruption message says, is a resume; other options
+  // are refused, naming what they would change.
+  const CliRun same = iesrgs(
+      train + " --preset fast --iterations 10 --set random_points=500 --set init=random --resume");
+  ASSERT_EQ(same.status, 0) << same.output;
+  EXPECT_EQ(read_file(dir / "run" / "point_cloud.ply"), model);
+  const CliRun longer = iesrgs(train + " --resume --preset fast --iterations 20");
   EXPECT_EQ(longer.status, 1);
-  EXPECT_TRUE(contains(last_line(longer.output), "--iterations cannot change a resumed run"))
+  EXPECT_TRUE(contains(last_line(longer.output), "would change it (") &&
+              contains(last_line(longer.output), "iterations 20 instead of 10"))
       << longer.output;
   const CliRun halved = iesrgs(train + " --resume --downscale 2");
   EXPECT_EQ(halved.status, 1);
   EXPECT_TRUE(contains(last_line(halved.output), "cameras.json: the run trained on other cameras"))
       << halved.output;
-  const CliRun reseeded = iesrgs(train + " --resume --seed 3");
-  EXPECT_EQ(reseeded.status, 1);
-  EXPECT_TRUE(contains(last_line(reseeded.output), "--seed cannot change a resumed run"))
-      << reseeded.output;
+  const CliRun black = iesrgs(train + " --resume --background black");
+  EXPECT_EQ(black.status, 1);
+  EXPECT_TRUE(contains(last_line(black.output), "the run trained over the background 1,1,1"))
+      << black.output;
+
+  // A new run into the folder replaces the earlier one whole: no checkpoint of it is left for a
+  // --resume to continue under the new config, and the log starts again.
+  ASSERT_EQ(iesrgs(train + " --preset fast --iterations 5 --set random_points=500").status, 0);
+  EXPECT_EQ(read_file(dir / "run" / "train_log.csv").find("\n6,"), std::string::npos);
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir / "run" / "training.json"))["iterations"], 5);
 }
 
 // A second process writing into a folder in use (a resume started while the run goes on) would

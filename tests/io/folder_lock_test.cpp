@@ -41,6 +41,20 @@ TEST(FolderLock, FoldersItCreatedAndLeftEmptyAreRemoved) {
   EXPECT_TRUE(std::filesystem::is_directory(dir / "given"));  // the user's own folder stays
 }
 
+// A writer killed mid-write leaves "<name>.tmp-<pid>"; with the folder held, none is in use.
+TEST(FolderLock, TakingItRemovesWhatKilledWritersLeft) {
+  TempDir dir;
+  std::filesystem::create_directories(dir / "run" / "rows");
+  for (const char* name :
+       {"checkpoint.pt.tmp-4242", "rows/r_0.png.tmp-7", "notes.tmp-draft", "rows/point_cloud.ply"})
+    std::ofstream(dir / "run" / name) << "x";
+  FolderLock lock(dir / "run");
+  EXPECT_FALSE(std::filesystem::exists(dir / "run" / "checkpoint.pt.tmp-4242"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "run" / "rows/r_0.png.tmp-7"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "run" / "notes.tmp-draft"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "run" / "rows/point_cloud.ply"));
+}
+
 TEST(FolderLock, AFileInTheWayIsNamed) {
   TempDir dir;
   const auto file = dir / "taken";

@@ -2,7 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
 #include <string>
+#include <vector>
+
+#include "io/atomic_file.hpp"
+#include "support/temp_dir.hpp"
 
 namespace iesrgs::train {
 namespace {
@@ -29,6 +34,35 @@ TEST(Progress, ItemPaceGivesTheItemsSecondsAndTheEta) {
   EXPECT_EQ(last.substr(last.size() - end.size()), end);
   EXPECT_EQ(last.find('.'), last.size() - end.size() - 3) << "two decimals: " << last;
   EXPECT_GE(std::stod(last), 0.0);
+}
+
+std::vector<std::string> lines_of(const std::filesystem::path& file) {
+  std::vector<std::string> lines;
+  std::istringstream in(read_file(file));
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// A resumed run continues the log at its checkpoint: rows written after it, or cut off by a
+// killed process, go; the training time goes on from the checkpoint's.
+TEST(Progress, AResumedLogContinuesFromItsCheckpoint) {
+  testing::TempDir dir;
+  const auto csv = dir / "train_log.csv";
+  write_file_atomically(csv,
+                        "iteration,loss,gaussians,elapsed_seconds,test_psnr\n"
+                        "1,0.5,10,0.1,\n2,0.4,10,0.2,\n3,0.3,10,0.3,\n4,0.2,1");
+  {
+    ProgressLog log(csv, 2, 10, 5.0);
+    log.record(3, 0.25, 12, std::nullopt, false);
+  }
+  const std::vector<std::string> resumed = lines_of(csv);
+  ASSERT_EQ(resumed.size(), 4u);
+  EXPECT_EQ(resumed[2], "2,0.4,10,0.2,");
+  EXPECT_EQ(resumed[3].rfind("3,0.25,12,", 0), 0u) << resumed[3];
+  EXPECT_GE(std::stod(resumed[3].substr(std::string("3,0.25,12,").size())), 5.0);
+
+  { ProgressLog fresh(csv, 0, 10, 0.0); }  // a new run starts the log again
+  EXPECT_EQ(lines_of(csv).size(), 1u);
 }
 
 }  // namespace

@@ -6,9 +6,12 @@
 #include <chrono>
 #include <csignal>
 #include <limits>
+#include <sstream>
+#include <string>
 #include <thread>
 
 #include "core/device.hpp"
+#include "io/atomic_file.hpp"
 #include "io/ply.hpp"
 #include "loss/autograd.hpp"
 #include "support/cuda_device.hpp"
@@ -164,6 +167,30 @@ TEST_F(TrainerTest, InterruptedRunResumesToTheSameModel) {
   EXPECT_EQ(resumed.iterations, 40);
   EXPECT_EQ(max_difference(second.model(), straight.model()), 0.0);
   EXPECT_GT(resumed.seconds, second_run.count() + 0.9);  // both runs' training time
+  // One log row per iteration, in order, across both runs.
+  std::istringstream log(read_file(resumed_dir / "train_log.csv"));
+  std::string row;
+  std::getline(log, row);
+  int rows = 0;
+  while (std::getline(log, row)) ASSERT_EQ(row.rfind(std::to_string(++rows) + ",", 0), 0u) << row;
+  EXPECT_EQ(rows, 40);
+}
+
+// SIGTERM (kill, timeout, a container stopping) checkpoints and returns as Ctrl-C does.
+TEST_F(TrainerTest, TerminationCheckpointsAsCtrlCDoes) {
+  TempDir out;
+  TrainerSetup s = setup(out.path());
+  const std::vector<TrainView> views = s.train_views;
+  int calls = 0;
+  s.loss = [&](int view, const raster::RenderOutput& render) {
+    if (++calls == 5 * 3) std::raise(SIGTERM);
+    return loss::photometric_autograd(render.image, views[size_t(view)].target, 0.2);
+  };
+  Trainer trainer(config(), std::move(s), initial());
+  const TrainSummary summary = trainer.run();
+  EXPECT_TRUE(summary.interrupted);
+  EXPECT_EQ(summary.iterations, 5);
+  EXPECT_TRUE(std::filesystem::exists(trainer.checkpoint_path()));
 }
 
 TEST_F(TrainerTest, NonFiniteLossStopsWithTheCheckpointNamed) {
