@@ -66,6 +66,14 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   for (const char* frame : {"path_0000", "path_0001", "path_0002"})
     EXPECT_EQ(read_image_header(dir / "orbit" / "rgb" / (std::string(frame) + ".png")).width, 32)
         << frame;
+  // Rendered again with fewer frames: the earlier render's last frame must not stay among them.
+  ASSERT_EQ(iesrgs("render " + out + " " + scene + " -o " + (dir / "orbit").string() +
+                   " --path orbit --frames 2")
+                .status,
+            0);
+  for (const char* folder : {"rgb", "depth", "alpha"})
+    EXPECT_FALSE(std::filesystem::exists(dir / "orbit" / folder / "path_0002.png")) << folder;
+  EXPECT_TRUE(std::filesystem::exists(dir / "orbit" / "rgb" / "path_0001.png"));
 
   const CliRun bench = iesrgs("bench raster --model " + out + " --scene " + scene +
                               " --scale 2 --views 3 --iterations 1");
