@@ -49,6 +49,8 @@ class GroundTruth {
  public:
   GroundTruth(const EvalArgs& args, const SceneOptions& options) : root_(args.ground_truth) {
     background_ = options.background;
+    if (!is_scene(root_) && !std::filesystem::is_directory(root_))
+      fail_file(root_, "ground truth not found: neither a scene nor a folder of images");
     if (is_scene(root_)) {
       scene_.emplace(load_scene(root_, options));
       images_.emplace(*scene_);
@@ -119,9 +121,11 @@ void run_eval(const EvalArgs& args) {
   const std::filesystem::path base = args.output.empty()
                                          ? std::filesystem::path(args.renders) / "metrics"
                                          : std::filesystem::path(args.output);
+  // A mean over part of a split is not the split's score: say so, in the report and next to the
+  // numbers.
+  report.unscored = truth.unscored(report.views);
+  const std::vector<std::string>& unscored = report.unscored;
   eval::write_report(base, report);
-  // A mean over part of a split is not the split's score: say so, next to the numbers.
-  const std::vector<std::string> unscored = truth.unscored(report.views);
   if (!unscored.empty())
     fmt::print(
         "note: {} views of the {} split have no render and are not in the mean: {}{}\n",

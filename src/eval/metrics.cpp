@@ -79,6 +79,7 @@ void write_report(const std::filesystem::path& base, const MetricsReport& report
   nlohmann::json json = {
       {"mean", to_json(mean)}, {"views", nlohmann::json::array()}, {"lpips", report.lpips_status}};
   for (const ViewMetrics& v : report.views) json["views"].push_back(to_json(v));
+  if (!report.unscored.empty()) json["unscored_views"] = report.unscored;
   write_file_atomically(base.string() + ".json", json.dump(2) + "\n");
 
   std::string csv = "name,psnr,ssim,lpips\n";

@@ -24,7 +24,8 @@ struct ViewMetrics {
 
 struct MetricsReport {
   std::vector<ViewMetrics> views;
-  std::string lpips_status;  // "alex", "vgg", or why LPIPS is unavailable
+  std::string lpips_status;           // "alex", "vgg", or why LPIPS is unavailable
+  std::vector<std::string> unscored;  // views of the split with no render: not in the mean
 
   ViewMetrics mean() const;  // name "mean"; lpips only when every view has it
 };

@@ -1,6 +1,8 @@
 // End-to-end checks of the iesrgs binary: exit codes and one-line errors as a user sees them.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -219,6 +221,14 @@ TEST(Cli, EvalOfPartOfASplitNamesTheViewsLeftOut) {
                        "1 views of the test split have no render and are not in the "
                        "mean: r_1\n1 views: PSNR inf dB"))
       << run.output;
+  const auto report = nlohmann::json::parse(read_file(dir / "renders" / "metrics.json"));
+  EXPECT_EQ(report["unscored_views"], nlohmann::json::array({"r_1"}));
+
+  const CliRun nowhere =
+      iesrgs("eval --lpips none " + (dir / "renders").string() + " " + (dir / "none").string());
+  EXPECT_EQ(nowhere.status, 1);
+  EXPECT_TRUE(contains(last_line(nowhere.output), "none: ground truth not found"))
+      << nowhere.output;
 }
 
 }  // namespace
