@@ -361,7 +361,7 @@ TrainSummary Trainer::run() {
       log.flush();  // first: a resume keeps the rows up to its checkpoint and drops the rest
       save_checkpoint();
     }
-    if (interrupted) {
+    if (interrupted && !last) {  // on the last iteration, the run has finished: let it end
       fmt::print("interrupted: checkpoint of iteration {} saved to {}\n", iteration_,
                  checkpoint_path().string());
       summary.interrupted = true;
