@@ -22,6 +22,13 @@ using testing::iesrgs;
 using testing::last_line;
 using testing::TempDir;
 
+// Edits a PNG: every value inverted.
+void invert(const std::filesystem::path& png) {
+  Image8 image = read_image8(png);
+  for (uint8_t& value : image.data) value = uint8_t(255 - value);
+  write_png(png, image);
+}
+
 // Short schedules and few Gaussians: this checks the plumbing, not the quality.
 constexpr const char* kTinySchedule =
     " --sr-model bicubic --iterations 20 --internal-iterations 20 --set random_points=1500"
@@ -36,6 +43,11 @@ class RunCli : public ::testing::Test {
                   std::to_string(views) + " --test-views " + std::to_string(test_views) +
                   " --seed 3")
         .status;
+  }
+
+  // `iesrgs run` of the scene into the run folder on the short schedule: `rows`, then `extra`.
+  CliRun run_rows(const std::string& rows, const std::string& extra = "") const {
+    return iesrgs("run " + scene + " -o " + out + " --rows " + rows + extra + kTinySchedule);
   }
 
   TempDir dir;
@@ -171,9 +183,8 @@ TEST_F(RunCli, AMissingCheckpointLeavesNoOutputFolder) {
 // The ETA is for the rows left to train: after external here, none, since ie-srgs is cached.
 TEST_F(RunCli, RowsReusedFromTheCacheAreLeftOutOfTheEta) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
-  const std::string rows = "run " + scene + " -o " + out + " --rows ";
-  ASSERT_EQ(iesrgs(rows + "ie-srgs" + kTinySchedule).status, 0);
-  const CliRun run = iesrgs(rows + "external,ie-srgs" + kTinySchedule);
+  ASSERT_EQ(run_rows("ie-srgs").status, 0);
+  const CliRun run = run_rows("external,ie-srgs");
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_TRUE(contains(run.output, "HR rows: 1 of 2 done in ")) << run.output;
   EXPECT_FALSE(contains(run.output, "for the rest")) << run.output;
@@ -183,8 +194,7 @@ TEST_F(RunCli, RowsReusedFromTheCacheAreLeftOutOfTheEta) {
 // E_depth row without a depth model (so trained as external only).
 TEST_F(RunCli, RowLabelsSayWhatTrainedThem) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
-  const CliRun run = iesrgs("run " + scene + " -o " + out +
-                            " --rows ie-srgs,external-depth --texture external" + kTinySchedule);
+  const CliRun run = run_rows("ie-srgs,external-depth", " --texture external");
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_TRUE(contains(run.output, "== row 2/2 ie-srgs: IE-SRGS, external texture (no mask) =="))
       << run.output;
@@ -196,7 +206,7 @@ TEST_F(RunCli, RowLabelsSayWhatTrainedThem) {
 TEST_F(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
   ASSERT_EQ(write_scene(16, 5, 1), 0);
   // The folder's earlier table, from a benchmark of the same images, has an hr row.
-  ASSERT_EQ(iesrgs("run " + scene + " -o " + out + " --rows hr" + kTinySchedule).status, 0);
+  ASSERT_EQ(run_rows("hr").status, 0);
   const CliRun run = iesrgs("run " + scene + " -o " + out + " --input-is-lr" + kTinySchedule);
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_EQ(read_image_header(dir / "run" / "rows/ie-srgs/test/rgb/r_0.png").width, 64);
@@ -206,8 +216,7 @@ TEST_F(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
   EXPECT_FALSE(results["rows"][0].contains("psnr"));
 
   for (const char* row : {"hr", "mask-oracle"}) {
-    const CliRun needs_truth =
-        iesrgs("run " + scene + " -o " + out + " --input-is-lr --rows " + row + kTinySchedule);
+    const CliRun needs_truth = run_rows(row, " --input-is-lr");
     EXPECT_EQ(needs_truth.status, 1) << row;
     EXPECT_TRUE(contains(last_line(needs_truth.output), "need HR images")) << needs_truth.output;
   }
@@ -224,10 +233,9 @@ TEST_F(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
     ADD_FAILURE() << "no internal row in " << results.dump();
     return 0.0;
   };
-  ASSERT_EQ(iesrgs("run " + scene + " -o " + out + " --rows internal" + kTinySchedule).status, 0);
+  ASSERT_EQ(run_rows("internal").status, 0);
   const double alone = internal_psnr();
-  const CliRun after_bicubic = iesrgs("run " + scene + " -o " + out +
-                                      " --init internal --rows bicubic,internal" + kTinySchedule);
+  const CliRun after_bicubic = run_rows("bicubic,internal", " --init internal");
   ASSERT_EQ(after_bicubic.status, 0) << after_bicubic.output;
   EXPECT_EQ(internal_psnr(), alone);
 }
@@ -236,9 +244,8 @@ TEST_F(RunCli, RowsStartingFromTheInternalModelLeaveItUnchanged) {
 // that scored the old one.
 TEST_F(RunCli, RetrainedInternalModelDropsTheEarlierInternalRow) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
-  const std::string rows = "run " + scene + " -o " + out + " --rows ";
-  ASSERT_EQ(iesrgs(rows + "internal,external" + kTinySchedule).status, 0);
-  const CliRun retrained = iesrgs(rows + "joint --internal-set seed=7" + kTinySchedule);
+  ASSERT_EQ(run_rows("internal,external").status, 0);
+  const CliRun retrained = run_rows("joint", " --internal-set seed=7");
   ASSERT_EQ(retrained.status, 0) << retrained.output;
   const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
   std::vector<std::string> ids;
@@ -250,14 +257,13 @@ TEST_F(RunCli, RetrainedInternalModelDropsTheEarlierInternalRow) {
 // row again and stopped before writing the table leaves the old entry behind.
 TEST_F(RunCli, AnEarlierRowIsKeptOnlyForTheModelItScored) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
-  const std::string rows = "run " + scene + " -o " + out + " --rows ";
-  ASSERT_EQ(iesrgs(rows + "bicubic,external" + kTinySchedule).status, 0);
+  ASSERT_EQ(run_rows("bicubic,external").status, 0);
   const auto results_path = dir / "run" / "results.json";
   auto results = nlohmann::json::parse(read_file(results_path));
   ASSERT_EQ(results["rows"][1]["row"], "external");
   results["rows"][1]["train_seconds"] = results["rows"][1]["train_seconds"].get<double>() + 1;
   write_file_atomically(results_path, results.dump());
-  ASSERT_EQ(iesrgs(rows + "bicubic" + kTinySchedule).status, 0);
+  ASSERT_EQ(run_rows("bicubic").status, 0);
   results = nlohmann::json::parse(read_file(results_path));
   ASSERT_EQ(results["rows"].size(), 1u) << results.dump();
   EXPECT_EQ(results["rows"][0]["row"], "bicubic");
@@ -278,13 +284,10 @@ TEST_F(RunCli, AnEditedTruthRetrainsTheOracleRow) {
               hr.data[size_t((4 * y * 32 + 4 * x) * hr.channels + c)];
     write_png(dir / "scene/train_4" / name, lr);
   }
-  const std::string command = "run " + scene + " -o " + out + " --rows mask-oracle" + kTinySchedule;
-  ASSERT_EQ(iesrgs(command).status, 0);
+  ASSERT_EQ(run_rows("mask-oracle").status, 0);
   const auto truth = dir / "scene/train/r_1.png";
-  Image8 edited = read_image8(truth);
-  for (uint8_t& value : edited.data) value = uint8_t(255 - value);
-  write_png(truth, edited);
-  const CliRun again = iesrgs(command);
+  invert(truth);
+  const CliRun again = run_rows("mask-oracle");
   ASSERT_EQ(again.status, 0) << again.output;
   EXPECT_TRUE(contains(again.output, "external stage: 0 views computed")) << again.output;
   EXPECT_FALSE(contains(again.output,
@@ -295,9 +298,8 @@ TEST_F(RunCli, AnEditedTruthRetrainsTheOracleRow) {
 // T shapes the discrepancy mask alone: another T trains the ie-srgs row again, not the others.
 TEST_F(RunCli, AnotherThresholdRetrainsOnlyTheMaskedRow) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
-  const std::string rows = "run " + scene + " -o " + out + " --rows external,ie-srgs";
-  ASSERT_EQ(iesrgs(rows + kTinySchedule).status, 0);
-  const CliRun again = iesrgs(rows + " --threshold 0.3" + kTinySchedule);
+  ASSERT_EQ(run_rows("external,ie-srgs").status, 0);
+  const CliRun again = run_rows("external,ie-srgs", " --threshold 0.3");
   ASSERT_EQ(again.status, 0) << again.output;
   const std::string rows_dir = (dir / "run" / "rows").string();
   EXPECT_TRUE(contains(again.output, "reusing the finished model in " + rows_dir + "/external"))
@@ -327,13 +329,10 @@ TEST_F(RunCli, RowsOfTheAutomaticPriorAreKeptByARunWithoutThem) {
 // row too, though its model learnt from the unchanged training views.
 TEST_F(RunCli, RowsScoredAgainstOtherTestViewsLeaveTheTable) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
-  const std::string rows = "run " + scene + " -o " + out + " --rows ";
-  ASSERT_EQ(iesrgs(rows + "internal,bicubic" + kTinySchedule).status, 0);
+  ASSERT_EQ(run_rows("internal,bicubic").status, 0);
   const auto test_image = dir / "scene/test/r_0.png";
-  Image8 edited = read_image8(test_image);
-  for (uint8_t& value : edited.data) value = uint8_t(255 - value);
-  write_png(test_image, edited);
-  const CliRun again = iesrgs(rows + "bicubic" + kTinySchedule);
+  invert(test_image);
+  const CliRun again = run_rows("bicubic");
   ASSERT_EQ(again.status, 0) << again.output;
   const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
   ASSERT_EQ(results["rows"].size(), 1u) << results.dump();
@@ -359,9 +358,7 @@ TEST_F(RunCli, EditedTrainingImageRecomputesWhatLearntFromIt) {
   EXPECT_FALSE(contains(copied.output, "it/s |")) << copied.output;
 
   const auto moved_image = dir / "moved/train/r_1.png";
-  Image8 edited = read_image8(moved_image);
-  for (uint8_t& value : edited.data) value = uint8_t(255 - value);
-  write_png(moved_image, edited);
+  invert(moved_image);
   const CliRun changed = iesrgs(command("moved"));
   ASSERT_EQ(changed.status, 0) << changed.output;
   EXPECT_TRUE(contains(changed.output, "1 views computed, 3 reused")) << changed.output;
