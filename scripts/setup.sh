@@ -38,11 +38,16 @@ scripts/apt-install.sh "${PACKAGES[@]}"
 # Thick (115 MB) is the one `--sr-model auto` uses; slim (4 MB) is checked against TensorFlow.js
 # (kSetupEsrganVariants in src/priors/sr/esrgan.hpp). One command for both: npm would remove the
 # other unsaved package.
-packages=third_party/npm/node_modules/@upscalerjs
+npm_dir=${IESRGS_NPM_DIR:-third_party/npm}
+packages=$npm_dir/node_modules/@upscalerjs
 if [ ! -f "$packages/esrgan-thick/models/x4/model.json" ] ||
    [ ! -f "$packages/esrgan-slim/models/x4/model.json" ]; then
-  npm install --prefix third_party/npm --no-save --omit=peer --no-audit --no-fund \
-    @upscalerjs/esrgan-thick@1.0.0 @upscalerjs/esrgan-slim@1.0.0
+  # Not fatal: without them `--sr-model auto` takes SAFMN's checkpoint or bicubic, and their tests
+  # skip.
+  npm install --prefix "$npm_dir" --no-save --omit=peer --no-audit --no-fund \
+    @upscalerjs/esrgan-thick@1.0.0 @upscalerjs/esrgan-slim@1.0.0 ||
+    echo "warning: npm could not install the ESRGAN models into $npm_dir; run setup again" \
+      "to retry (until then --sr-model auto falls back to SAFMN or bicubic)" >&2
 fi
 
 cmake -S . -B "$build_dir" "${options[@]}" >/dev/null
