@@ -1,9 +1,11 @@
 #include "io/atomic_file.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <fstream>
 #include <sstream>
 #include <string_view>
@@ -23,14 +25,24 @@ fs::path temporary_path(const fs::path& path) {
   return path.string() + std::string(kTemporaryMark) + std::to_string(::getpid());
 }
 
-// "<name>.tmp-<digits>", as temporary_path names them.
-bool is_temporary(const fs::path& path) {
+// A temporary of one of our outputs, "<name>.<ext>.tmp-<pid>" as temporary_path names them,
+// whose writer is no longer running. Other programs' files never match: only the extensions of
+// what iesrgs writes count.
+bool is_stale_temporary(const fs::path& path) {
   const std::string name = path.filename().string();
   const size_t mark = name.rfind(kTemporaryMark);
   if (mark == std::string::npos || mark == 0) return false;
-  const size_t digits = mark + kTemporaryMark.size();
-  return digits < name.size() && std::all_of(name.begin() + std::ptrdiff_t(digits), name.end(),
-                                             [](unsigned char c) { return std::isdigit(c); });
+  const std::string digits = name.substr(mark + kTemporaryMark.size());
+  if (digits.empty() || digits.size() > 9 ||
+      !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); }))
+    return false;
+  const std::string extension = fs::path(name.substr(0, mark)).extension().string();
+  const bool ours = extension == ".pt" || extension == ".ply" || extension == ".png" ||
+                    extension == ".npy" || extension == ".json" || extension == ".csv" ||
+                    extension == ".spz" || extension == ".splat" || extension == ".md" ||
+                    extension == ".html";
+  const pid_t writer = pid_t(std::stol(digits));
+  return ours && writer != ::getpid() && ::kill(writer, 0) != 0 && errno == ESRCH;
 }
 
 }  // namespace
@@ -54,10 +66,9 @@ void write_atomically(const fs::path& path, const std::function<void(const fs::p
 
 void remove_stale_temporaries(const fs::path& folder) {
   std::error_code walk;
-  for (fs::recursive_directory_iterator it(folder, walk), end; !walk && it != end;
-       it.increment(walk)) {
+  for (fs::directory_iterator it(folder, walk), end; !walk && it != end; it.increment(walk)) {
     std::error_code ec;  // an entry that cannot be checked or removed is left alone
-    if (it->is_regular_file(ec) && is_temporary(it->path())) fs::remove(it->path(), ec);
+    if (it->is_regular_file(ec) && is_stale_temporary(it->path())) fs::remove(it->path(), ec);
   }
 }
 

@@ -16,8 +16,7 @@ void write_atomically(const std::filesystem::path& path,
 void write_file_atomically(const std::filesystem::path& path, const std::string& bytes);
 
 // Removes the temporaries that processes killed mid-write (a second Ctrl-C, kill -9, the OOM
-// killer) left anywhere below `folder`. Only for a folder this process holds locked, where no
-// other write can be under way.
+// killer) left in `folder` (not below it): those of our outputs' kinds whose writer is gone.
 void remove_stale_temporaries(const std::filesystem::path& folder);
 
 // Whole file into memory; throws Error naming the file when it cannot be read.

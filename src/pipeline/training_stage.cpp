@@ -61,6 +61,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
       fmt::print("{}: {}; writing it again\n", name, e.what());
     }
   }
+  remove_stale_temporaries(dir);  // a killed run's half-written checkpoint, say
   const fs::path checkpoint = train::checkpoint_path(dir);
   const bool resumable =
       stage_json(dir).value("params", nlohmann::json()) == identity && fs::exists(checkpoint);
