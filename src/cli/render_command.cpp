@@ -4,6 +4,9 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <set>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -36,6 +39,28 @@ struct RenderArgs {
   std::string device = "auto";
 };
 
+// The views an earlier render listed in the folder's render.json that this one does not make
+// (fewer path frames, another split): they would mix with its own. Only files that render wrote.
+void remove_earlier_views(const std::filesystem::path& dir, const std::vector<Camera>& cameras) {
+  const std::filesystem::path report = dir / "render.json";
+  if (!std::filesystem::exists(report)) return;
+  const nlohmann::json earlier = nlohmann::json::parse(read_file(report), nullptr, false);
+  if (!earlier.is_object() || !earlier.contains("names") || !earlier["names"].is_array()) return;
+  std::set<std::string> names;
+  for (const Camera& camera : cameras) names.insert(camera.name);
+  for (const nlohmann::json& name : earlier["names"]) {
+    if (!name.is_string() || names.count(name.get<std::string>())) continue;
+    const std::string view = name.get<std::string>();
+    for (const std::filesystem::path& file :
+         {dir / "rgb" / (view + ".png"), dir / "depth" / (view + ".npy"),
+          dir / "depth" / (view + ".png"), dir / "alpha" / (view + ".png")}) {
+      std::error_code ec;
+      if (!std::filesystem::remove(file, ec) && ec)
+        fail_file(file, "an earlier render's view cannot be removed: " + ec.message());
+    }
+  }
+}
+
 void run_render(const RenderArgs& args) {
   use_device(args.device);
   gs::GaussianModel model =
@@ -66,15 +91,19 @@ void run_render(const RenderArgs& args) {
   const char* mode = model.antialiased ? "antialiased" : "classic";
   fmt::print("rendering {} {} views of {} Gaussians at x{} ({})\n", cameras.size(), what,
              model.size(), args.scale, mode);
+  remove_earlier_views(args.output, cameras);
   const double seconds =
       pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
+  std::vector<std::string> names;
+  for (const Camera& camera : cameras) names.push_back(camera.name);
   const nlohmann::json report = {{"views", cameras.size()},
                                  {"width", first.intrinsics.width},
                                  {"height", first.intrinsics.height},
                                  {"gaussians", model.size()},
                                  {"rasterize_mode", mode},
                                  {"seconds_per_view", seconds},
-                                 {"fps", seconds > 0 ? 1.0 / seconds : 0.0}};
+                                 {"fps", seconds > 0 ? 1.0 / seconds : 0.0},
+                                 {"names", names}};
   write_file_atomically(std::filesystem::path(args.output) / "render.json", report.dump(2) + "\n");
   fmt::print("{:.1f} ms per view ({:.1f} FPS); wrote {}\n", seconds * 1e3,
              seconds > 0 ? 1.0 / seconds : 0.0, args.output);

@@ -5,11 +5,7 @@
 
 #include <chrono>
 #include <cmath>
-#include <set>
-#include <string>
-#include <vector>
 
-#include "core/error.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "io/npy.hpp"
@@ -64,35 +60,9 @@ void write_rendered_view(const std::filesystem::path& dir, const std::string& na
   write_png(dir / "alpha" / (name + ".png"), gray_image8(view.alpha));
 }
 
-namespace {
-
-// Views an earlier render left in `dir` that this one does not make (another split, fewer path
-// frames): they would mix with its own.
-void remove_other_views(const std::filesystem::path& dir, const std::vector<Camera>& cameras) {
-  std::set<std::string> names;
-  for (const Camera& camera : cameras) names.insert(camera.name);
-  std::vector<std::filesystem::path> others;
-  for (const char* folder : {"rgb", "depth", "alpha"}) {
-    std::error_code ec;  // a folder not there yet has nothing to remove
-    for (const auto& entry : std::filesystem::directory_iterator(dir / folder, ec)) {
-      const std::filesystem::path& file = entry.path();
-      const bool view = file.extension() == ".png" || file.extension() == ".npy";
-      if (view && !names.count(file.stem().string())) others.push_back(file);
-    }
-  }
-  for (const std::filesystem::path& file : others) {
-    std::error_code ec;
-    if (!std::filesystem::remove(file, ec) && ec)
-      fail_file(file, "an earlier render's view cannot be removed: " + ec.message());
-  }
-}
-
-}  // namespace
-
 double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,
                        const std::vector<Camera>& cameras, const std::array<float, 3>& background,
                        double scale) {
-  remove_other_views(dir, cameras);
   // One untimed frame first: a process's first render pays for loading the GPU kernels and
   // growing the allocator's pools, which would otherwise count against the rendering speed.
   if (!cameras.empty()) render_view(model, cameras.front().scaled(scale), background);

@@ -31,8 +31,7 @@ void write_rendered_view(const std::filesystem::path& dir, const std::string& na
                          const RenderedView& view);
 
 // Renders every camera (at `scale` times its resolution) into `dir`, printing progress; returns
-// the mean rendering time in seconds per view, after one untimed warm-up frame. The views of an
-// earlier render in `dir` that these cameras do not make are removed first.
+// the mean rendering time in seconds per view, after one untimed warm-up frame.
 double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,
                        const std::vector<Camera>& cameras, const std::array<float, 3>& background,
                        double scale);
