@@ -4,7 +4,6 @@
 #include <fmt/core.h>
 
 #include <algorithm>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -39,17 +38,18 @@ struct RenderArgs {
   std::string device = "auto";
 };
 
-// The views an earlier render listed in the folder's render.json that this one does not make
-// (fewer path frames, another split): they would mix with its own. Only files that render wrote.
-void remove_earlier_views(const std::filesystem::path& dir, const std::vector<Camera>& cameras) {
+// The views an earlier render listed in the folder's render.json that this one, of the views
+// `names`, does not make (fewer path frames, another split): they would mix with its own. Only
+// files that render wrote.
+void remove_earlier_views(const std::filesystem::path& dir, const std::vector<std::string>& names) {
   const std::filesystem::path report = dir / "render.json";
   if (!std::filesystem::exists(report)) return;
   const nlohmann::json earlier = nlohmann::json::parse(read_file(report), nullptr, false);
   if (!earlier.is_object() || !earlier.contains("names") || !earlier["names"].is_array()) return;
-  std::set<std::string> names;
-  for (const Camera& camera : cameras) names.insert(camera.name);
   for (const nlohmann::json& name : earlier["names"]) {
-    if (!name.is_string() || names.count(name.get<std::string>())) continue;
+    if (!name.is_string() ||
+        std::find(names.begin(), names.end(), name.get<std::string>()) != names.end())
+      continue;
     const std::string view = name.get<std::string>();
     for (const std::filesystem::path& file :
          {dir / "rgb" / (view + ".png"), dir / "depth" / (view + ".npy"),
@@ -91,11 +91,11 @@ void run_render(const RenderArgs& args) {
   const char* mode = model.antialiased ? "antialiased" : "classic";
   fmt::print("rendering {} {} views of {} Gaussians at x{} ({})\n", cameras.size(), what,
              model.size(), args.scale, mode);
-  remove_earlier_views(args.output, cameras);
-  const double seconds =
-      pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
   std::vector<std::string> names;
   for (const Camera& camera : cameras) names.push_back(camera.name);
+  remove_earlier_views(args.output, names);
+  const double seconds =
+      pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
   const nlohmann::json report = {{"views", cameras.size()},
                                  {"width", first.intrinsics.width},
                                  {"height", first.intrinsics.height},

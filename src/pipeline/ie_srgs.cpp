@@ -182,6 +182,7 @@ class Pipeline {
   RowResult run_fusion_row(const RowSpec& row);
   // Whether the earlier table's `entry` for `row` is what these settings would give.
   bool row_current(const RowSpec& row, const nlohmann::json& entry, bool internal_current) const;
+  bool row_model_cached(const RowSpec& row) const;  // its HR model is trained for these settings
   void keep_earlier_rows(RunResult& result) const;
   void write_fusion_diagnostics(const gs::GaussianModel& model, const FusionSetup& setup) const;
   void write_mask_agreement(const FusionSetup& setup) const;
@@ -512,8 +513,7 @@ RunResult Pipeline::run() {
   std::vector<bool> hr_rows_to_train;
   for (const std::string& id : rows_)
     if (const RowSpec& row = row_spec(id); row.source != Source::Internal)
-      hr_rows_to_train.push_back(!training_stage_current(
-          o_.output / "rows" / row.id, row_params(row, row_weights(row)), o_.fusion_config));
+      hr_rows_to_train.push_back(!row_model_cached(row));
   HrRowProgress progress(std::move(hr_rows_to_train));
   for (size_t i = 0; i < rows_.size(); ++i) {
     const RowSpec& row = row_spec(rows_[i]);
@@ -545,8 +545,12 @@ bool Pipeline::row_current(const RowSpec& row, const nlohmann::json& entry,
   const bool internal = row.source == Source::Internal;
   const fs::path dir = internal ? o_.output / "internal" : o_.output / "rows" / row.id;
   if (entry.value("train_seconds", -1.0) != stage_seconds(dir)) return false;
-  return internal ||
-         training_stage_current(dir, row_params(row, row_weights(row)), o_.fusion_config);
+  return internal || row_model_cached(row);
+}
+
+bool Pipeline::row_model_cached(const RowSpec& row) const {
+  return training_stage_current(o_.output / "rows" / row.id, row_params(row, row_weights(row)),
+                                o_.fusion_config);
 }
 
 // A rerun with fewer rows keeps the others of the folder's table, as long as their cached stage
