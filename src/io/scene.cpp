@@ -1,6 +1,7 @@
 #include "io/scene.hpp"
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <map>
@@ -102,7 +103,11 @@ void require_trainable_views(const Scene& scene) {
   // 3DGS scales its position learning rate and densification by the spread of the training
   // cameras: views from one position give it none, and no position would be optimized.
   const SceneNormalization sphere = scene.normalization();
-  if (sphere.radius > 1e-9 * (1 + sphere.center.norm())) return;
+  if (sphere.radius > 1e-9 * (1 + sphere.center.norm())) {
+    if (const std::optional<std::string> warning = camera_spread_warning(scene))
+      spdlog::warn("{}: {}", scene.root.string(), *warning);
+    return;
+  }
   const size_t count = scene.split(Split::Train).size();
   const std::string views = count == 1
                                 ? "a single training view, at"
@@ -111,6 +116,28 @@ void require_trainable_views(const Scene& scene) {
                                     "from different positions, to see depth and to take the "
                                     "scene's scale from their spread",
                                     views, sphere.center.x, sphere.center.y, sphere.center.z));
+}
+
+std::optional<std::string> camera_spread_warning(const Scene& scene) {
+  const SceneNormalization sphere = scene.normalization();
+  // The depth of the scene as the cameras see it: the SfM points' median distance from the
+  // cameras' center, else the cameras' median distance to the point their optical axes meet.
+  std::vector<double> distances;
+  for (const Vec3& point : scene.points.positions)
+    distances.push_back((point - sphere.center).norm());
+  const std::vector<const Camera*> cameras = scene.split(Split::Train);
+  if (distances.empty())
+    if (const std::optional<Vec3> focus = focus_point(cameras))
+      for (const Camera* camera : cameras) distances.push_back((camera->center() - *focus).norm());
+  if (distances.empty()) return std::nullopt;
+  const double depth = median(distances);
+  const double spread = sphere.radius / 1.1;
+  if (!(spread < kNarrowSpread * depth)) return std::nullopt;
+  return fmt::format(
+      "the {} training cameras lie within {:.3g} of their center, {:.2g} % of the scene's depth "
+      "({:.3g}): views from nearly one position see little parallax, and 3DGS's position "
+      "learning rate and densification sizes, which scale with that spread, will be tiny",
+      cameras.size(), spread, 100 * spread / depth, depth);
 }
 
 Scene load_scene(const fs::path& given_root, const SceneOptions& options) {

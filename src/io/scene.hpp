@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,14 @@ bool is_scene(const std::filesystem::path& path);
 void require_training_views(const Scene& scene);
 
 // The same, and also when every training view is taken from one position: nothing to train on.
+// Logs camera_spread_warning's text when there is one.
 void require_trainable_views(const Scene& scene);
+
+// Training cameras spread over less than this fraction of the scene's depth are nearly at one
+// position (a forward-facing LLFF capture spreads over several percent).
+inline constexpr double kNarrowSpread = 0.01;
+
+// A warning when the training cameras are that close together, else nothing.
+std::optional<std::string> camera_spread_warning(const Scene& scene);
 
 }  // namespace iesrgs

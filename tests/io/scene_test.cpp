@@ -83,6 +83,34 @@ TEST(Scene, TrainingViewsFromOnePositionAreRefused) {
                        "all 3 training views at one position, (1, 2, 3)"));
 }
 
+// Cameras on a small patch facing SfM points `depth` away.
+Scene cameras_facing_points(double spread, double depth) {
+  Scene scene;
+  for (double x : {-spread, 0.0, spread}) {
+    Camera camera;
+    camera.translation = {-x, 0, 0};  // identity rotation: center (x, 0, 0), looking along +z
+    scene.cameras.push_back(camera);
+  }
+  for (double y : {-1.0, 1.0}) scene.points.positions.push_back({0, y, depth});
+  return scene;
+}
+
+TEST(Scene, CamerasNearlyAtOnePositionAreWarnedAbout) {
+  const std::optional<std::string> warning = camera_spread_warning(cameras_facing_points(0.05, 10));
+  ASSERT_TRUE(warning.has_value());
+  EXPECT_TRUE(contains(*warning, "the 3 training cameras lie within 0.05 of their center, 0.5 %"))
+      << *warning;
+  require_trainable_views(cameras_facing_points(0.05, 10));  // warned about, not refused
+  // A forward-facing capture spreads over a few percent of its depth.
+  EXPECT_FALSE(camera_spread_warning(cameras_facing_points(0.5, 10)).has_value());
+}
+
+TEST(Scene, CamerasAroundAnObjectAreNotWarnedAbout) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 4, 1});
+  EXPECT_FALSE(camera_spread_warning(load_scene(dir / "scene")).has_value());
+}
+
 TEST(Scene, ADownscaleThatLeavesNoPixelIsRefused) {
   TempDir dir;
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 1});
