@@ -16,6 +16,10 @@ namespace {
 // the arc they cover instead of the whole ellipse, which would look at the scene from behind.
 constexpr double kLargestGapForAFullTurn = kPi / 2;
 
+// How much less spread of the cameras' right axes the direction taken for up must have than any
+// other (the ratio of the second moments).
+constexpr double kClearlyLeastSpread = 0.1;
+
 // Where the training cameras stand around their focus point: the world's up direction, the ellipse
 // fitted to their positions in the plane across it, and their mean height.
 struct Ring {
@@ -25,8 +29,10 @@ struct Ring {
 };
 
 // People hold cameras level, so the world's up is the direction most nearly perpendicular to
-// every camera's right axis (the mean image up tilts towards what cameras look down at). Only
-// when all right axes are parallel does it fall back to the mean image up.
+// every camera's right axis (the mean image up tilts towards what cameras look down at). That
+// direction is only known when it is clearly the least spread of the right axes: on a narrow arc
+// the right axes are nearly parallel, and a little roll makes the two smaller spreads alike and
+// its direction noise. Then the mean image up, made perpendicular to the mean right axis, is used.
 Vec3 up_direction(const std::vector<const Camera*>& cameras) {
   Vec3 mean_up;
   torch::Tensor moments = torch::zeros({3, 3}, torch::kFloat64);
@@ -39,10 +45,13 @@ Vec3 up_direction(const std::vector<const Camera*>& cameras) {
   }
   mean_up = normalized(mean_up);
   const auto [values, vectors] = torch::linalg_eigh(moments, "L");  // ascending
-  if (values[1].item<double>() < 1e-3 * double(cameras.size())) return mean_up;
   const auto v = vectors.accessor<double, 2>();
-  const Vec3 up{v[0][0], v[1][0], v[2][0]};
-  return up.dot(mean_up) < 0 ? -up : up;
+  if (values[0].item<double>() < kClearlyLeastSpread * values[1].item<double>()) {
+    const Vec3 up{v[0][0], v[1][0], v[2][0]};
+    return up.dot(mean_up) < 0 ? -up : up;
+  }
+  const Vec3 right{v[0][2], v[1][2], v[2][2]};
+  return normalized(mean_up - right * mean_up.dot(right));
 }
 
 Ring fit_ring(const std::vector<const Camera*>& cameras) {
@@ -54,6 +63,14 @@ Ring fit_ring(const std::vector<const Camera*>& cameras) {
         "interpolated path follows the cameras instead)",
         cameras.size());
   ring.focus = *focus;
+  double farthest = 0;
+  for (const Camera* camera : cameras)
+    farthest = std::max(farthest, (camera->center() - ring.focus).norm());
+  if (farthest <= 1e-9 * (1 + ring.focus.norm()))
+    fail(
+        "the {} training cameras stand at the point they look around, ({:.6g}, {:.6g}, {:.6g}): "
+        "no circle to fly (an interpolated path follows the cameras instead)",
+        cameras.size(), ring.focus.x, ring.focus.y, ring.focus.z);
   ring.up = up_direction(cameras);
   // Any orthonormal basis of the plane across `up`.
   const Vec3 e1 =

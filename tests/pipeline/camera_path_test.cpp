@@ -77,6 +77,38 @@ TEST(CameraPath, ArcOfCamerasGivesASweepAlongItAndBack) {
   EXPECT_NEAR((path[1].center() - path[19].center()).norm(), 0, 1e-9);  // and back
 }
 
+// `camera` turned by `angle` about its optical axis, staying where it is.
+Camera rolled(Camera camera, double angle) {
+  Mat3 roll = quat_to_rotation(std::cos(angle / 2), 0, 0, std::sin(angle / 2));
+  camera.rotation = roll * camera.rotation;
+  camera.translation = roll * camera.translation;
+  return camera;
+}
+
+TEST(CameraPath, NarrowArcOfRolledCamerasKeepsTheWorldUp) {
+  // Nine cameras over 8 degrees, looking 10 degrees down at the target, each rolled by up to
+  // 4 degrees: the right axes alone cannot tell up from forward (they made it 51 degrees off).
+  std::vector<Camera> cameras;
+  for (int i = 0; i < 9; ++i) {
+    const double t = (i - 4.0) * kPi / 180, height = 3 * std::tan(10 * kPi / 180);
+    const double roll = 4 * std::cos(0.7 * i * i) * kPi / 180;
+    cameras.push_back(rolled(camera_at({3 * std::cos(t), 3 * std::sin(t), height}, {}), roll));
+  }
+  for (const Camera& camera : orbit_path(pointers(cameras), 8)) {
+    const Vec3 down{camera.rotation(1, 0), camera.rotation(1, 1), camera.rotation(1, 2)};
+    EXPECT_LT(std::acos(-down.z) * 180 / kPi, 12) << camera.name;  // level, but for the look down
+  }
+}
+
+TEST(CameraPath, CamerasAtTheirFocusPointAreAClearError) {
+  std::vector<Camera> panorama;
+  for (double turn : {0.0, 2.0, 4.0})
+    panorama.push_back(camera_at({1, 2, 3}, {1 + std::cos(turn), 2 + std::sin(turn), 3}));
+  const std::string message = testing::error_message([&] { orbit_path(pointers(panorama), 4); });
+  EXPECT_TRUE(testing::contains(message, "stand at the point they look around, (1, 2, 3)"))
+      << message;
+}
+
 TEST(CameraPath, ParallelCamerasAreAClearError) {
   const std::vector<Camera> cameras = {camera_at({0, 0, 0}, {0, 5, 0}),
                                        camera_at({1, 0, 0}, {1, 5, 0})};
