@@ -60,6 +60,22 @@ std::string view_fingerprint(const std::string& stage, const ViewImages& images,
   return bytes_digest(text);
 }
 
+ExternalView external_view(const Camera& camera, const ExternalOptions& options,
+                           const fs::path& dir) {
+  return {camera.name, dir / "image" / (camera.name + ".png"),
+          options.depth_model == "none" ? fs::path() : dir / "depth" / (camera.name + ".npy")};
+}
+
+// Whether the record holds `view` under `fingerprint` and its files are whole.
+bool view_cached(const nlohmann::json& record, const std::string& fingerprint,
+                 const ExternalView& view, const Camera& camera, int scale) {
+  if (record.value(view.name, "") != fingerprint) return false;
+  const Intrinsics upscaled = camera.intrinsics.scaled(scale);
+  if (cached_view_intact(view.image, view.depth, upscaled.width, upscaled.height)) return true;
+  fmt::print("external {}: the cached output is damaged or missing\n", view.name);
+  return false;
+}
+
 }  // namespace
 
 void resolve_sr_model(ExternalOptions& options, bool announce) {
@@ -84,17 +100,10 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
   const auto start = std::chrono::steady_clock::now();
   for (size_t i = 0; i < cameras.size(); ++i) {
     const Camera& camera = *cameras[i];
-    ExternalView view{
-        camera.name, dir / "image" / (camera.name + ".png"),
-        options.depth_model == "none" ? fs::path() : dir / "depth" / (camera.name + ".npy")};
+    const ExternalView view = external_view(camera, options, dir);
     views.push_back(view);
     const std::string fingerprint = view_fingerprint(stage, images, camera);
-    if (record.value(camera.name, "") == fingerprint) {
-      const Intrinsics upscaled = camera.intrinsics.scaled(options.scale);
-      if (cached_view_intact(view.image, view.depth, upscaled.width, upscaled.height)) continue;
-      fmt::print("external {}: the cached output is damaged or missing; computing it again\n",
-                 camera.name);
-    }
+    if (view_cached(record, fingerprint, view, camera, options.scale)) continue;
     if (!loaded) {
       sr = priors::sr::make_sr_net(options.sr_model, options.sr_weights, options.scale);
       depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights,
@@ -128,6 +137,17 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
   fmt::print("external stage: {} views computed, {} reused from {}\n", computed,
              cameras.size() - computed, dir.string());
   return views;
+}
+
+bool external_stage_current(const Scene& scene, ViewImages& images, const ExternalOptions& options,
+                            const fs::path& dir) {
+  const std::string stage = stage_identity(options);
+  const nlohmann::json record = read_stage_record(dir / "external.json");
+  for (const Camera* camera : scene.split(Split::Train))
+    if (!view_cached(record, view_fingerprint(stage, images, *camera),
+                     external_view(*camera, options, dir), *camera, options.scale))
+      return false;
+  return true;
 }
 
 }  // namespace iesrgs::pipeline

@@ -39,4 +39,9 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
                                              const ExternalOptions& options,
                                              const std::filesystem::path& dir);
 
+// Whether every training view's outputs in `dir` are cached for these options and intact, as
+// run_external_stage would find them.
+bool external_stage_current(const Scene& scene, ViewImages& images, const ExternalOptions& options,
+                            const std::filesystem::path& dir);
+
 }  // namespace iesrgs::pipeline

@@ -254,16 +254,21 @@ bool Pipeline::rows_use_internal_references() const {
 }
 
 void Pipeline::check_cached_inputs() const {
-  const auto require = [](const fs::path& record, const char* stage, const char* runners) {
-    if (!fs::exists(record))
-      fail_file(record, fmt::format("missing: the {} stage has not run here ({} with the same "
-                                    "scene and options runs it)",
-                                    stage, runners));
+  const auto require = [](bool current, const fs::path& dir, const char* stage,
+                          const char* runners) {
+    if (!current)
+      fail_file(dir, fmt::format("the {} stage here is missing, unfinished, or made from other "
+                                 "images or settings than these; {} with the same scene and "
+                                 "options makes it",
+                                 stage, runners));
   };
   if (any_row(Source::SuperResolved))
-    require(o_.output / "external" / "external.json", "external", "iesrgs run");
+    require(external_stage_current(lr_scene_, *lr_images_, o_.external, o_.output / "external"),
+            o_.output / "external", "external", "iesrgs run");
   if (rows_use_internal_references())
-    require(o_.output / "internal" / "stage.json", "internal", "iesrgs internal or iesrgs run");
+    require(internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
+                                   o_.output / "internal"),
+            o_.output / "internal", "internal", "iesrgs internal or iesrgs run");
 }
 
 void Pipeline::run_external_stages() {

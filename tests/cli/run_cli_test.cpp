@@ -148,7 +148,8 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
   const CliRun fuse = iesrgs("fuse " + scene + " -o " + out + kTinySchedule);
   EXPECT_EQ(fuse.status, 1);
-  EXPECT_TRUE(contains(last_line(fuse.output), "external.json: missing")) << fuse.output;
+  EXPECT_TRUE(contains(last_line(fuse.output), "external: the external stage here is missing"))
+      << fuse.output;
   EXPECT_FALSE(std::filesystem::exists(out));  // refused: no empty run folder left behind
 
   const CliRun rows = iesrgs("run " + scene + " -o " + out + " --rows best" + kTinySchedule);
@@ -164,6 +165,19 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   ASSERT_EQ(internal.status, 0) << internal.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "run" / "internal/sr/rgb/r_0.png"));
   EXPECT_FALSE(std::filesystem::exists(dir / "run" / "results.json"));
+
+  // fuse trains the HR rows alone: an internal model of other settings is refused, not retrained.
+  const std::string other_schedule =
+      " --sr-model bicubic --internal-iterations 21 --internal-set random_points=1500 --lpips none";
+  const CliRun stale = iesrgs("fuse " + scene + " -o " + out + " --rows internal" + other_schedule);
+  EXPECT_EQ(stale.status, 1);
+  EXPECT_TRUE(contains(last_line(stale.output), "internal: the internal stage here is missing"))
+      << stale.output;
+  EXPECT_FALSE(contains(stale.output, "it/s |")) << stale.output;
+  const CliRun current =
+      iesrgs("fuse " + scene + " -o " + out + " --rows internal" + kTinySchedule);
+  ASSERT_EQ(current.status, 0) << current.output;
+  EXPECT_TRUE(contains(current.output, "internal only")) << current.output;
 }
 
 // The SR network loads only once the stage has found a view to compute, after the output folder
