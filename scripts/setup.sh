@@ -35,7 +35,7 @@ scripts/apt-install.sh "${PACKAGES[@]}"
 
 # The default super-resolution prior: the MIT-licensed pre-trained ESRGAN models of UpscalerJS
 # (TensorFlow.js layers models), looked up at run time in $IESRGS_NPM_DIR or third_party/npm.
-# Thick (115 MB) is the one `--sr-model auto` uses; slim (4 MB) is checked against TensorFlow.js
+# Thick (115 MB) is the one `--sr-model auto` uses without SAFMN's checkpoint; slim (4 MB) is checked against TensorFlow.js
 # (kSetupEsrganVariants in src/priors/sr/esrgan.hpp). One command for both: npm would remove the
 # other unsaved package.
 npm_dir=${IESRGS_NPM_DIR:-third_party/npm}
