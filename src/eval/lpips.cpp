@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "priors/sr/registry.hpp"
 
 namespace iesrgs::eval {
 namespace {
@@ -139,12 +140,12 @@ const char* lpips_net_name(LpipsNet net) {
 }
 
 LpipsWeights default_lpips_weights(LpipsNet net) {
-  const std::string heads_file = std::string(spec(net).name) + ".pth";
-  if (auto dir = env_path("IESRGS_WEIGHTS_DIR")) {
-    return {*dir / spec(net).backbone_file, *dir / "lpips" / "v0.1" / heads_file};
-  }
-  return {torch_home() / "hub" / "checkpoints" / spec(net).backbone_file,
-          fs::path("..") / "shared" / "data" / "weights" / "lpips" / "v0.1" / heads_file};
+  const NetSpec& net_spec = spec(net);
+  fs::path backbone = torch_home() / "hub" / "checkpoints" / net_spec.backbone_file;
+  if (auto dir = env_path("IESRGS_WEIGHTS_DIR"); dir && is_file(*dir / net_spec.backbone_file))
+    backbone = *dir / net_spec.backbone_file;
+  return {backbone, priors::sr::default_weights_dir() / "lpips" / "v0.1" /
+                        (std::string(net_spec.name) + ".pth")};
 }
 
 std::optional<std::string> lpips_unavailable_reason(LpipsNet net, const LpipsWeights& weights) {

@@ -24,12 +24,11 @@ struct LpipsWeights {
   std::filesystem::path heads;     // LPIPS v0.1 linear heads, lin0..lin4
 };
 
-// Where the weights are when the user names none. Backbone: $IESRGS_WEIGHTS_DIR/<file> when the
-// variable is set, else torchvision's download cache $TORCH_HOME/hub/checkpoints/<file>
-// ($TORCH_HOME defaults to ~/.cache/torch), with torchvision's file names alexnet-owt-7be5be79.pth
-// and vgg16-397923af.pth. Heads: $IESRGS_WEIGHTS_DIR/lpips/v0.1/<net>.pth when the variable is set,
-// else the development data's copy ../shared/data/weights/lpips/v0.1/<net>.pth (relative to the
-// working directory, i.e. the repository root).
+// Where the weights are when the user names none. Backbone: $IESRGS_WEIGHTS_DIR/<file> when that
+// file exists, else torchvision's download cache $TORCH_HOME/hub/checkpoints/<file> ($TORCH_HOME
+// defaults to $XDG_CACHE_HOME/torch, else ~/.cache/torch), with torchvision's file names
+// alexnet-owt-7be5be79.pth and vgg16-397923af.pth. Heads: lpips/v0.1/<net>.pth in the weights
+// folder the SR checkpoints come from (priors::sr::default_weights_dir).
 LpipsWeights default_lpips_weights(LpipsNet net);
 
 // "<path>: no such file (<what it is>)" for the first missing file, nullopt when both exist.

@@ -13,6 +13,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
+#include "priors/sr/registry.hpp"
 #include "support/expect_error.hpp"
 #include "support/scoped_env.hpp"
 #include "support/temp_dir.hpp"
@@ -194,17 +195,22 @@ TEST(Lpips, ParsesTheOfficialNetworkNames) {
 
 // Sets an environment variable (or unsets it for nullopt) for one scope.
 TEST(Lpips, DefaultWeightsFollowTheWeightsDirectoryThenTorchsCache) {
+  testing::TempDir models;
+  ScopedEnv torch_home("TORCH_HOME", "/cache/torch");
   {
-    ScopedEnv weights("IESRGS_WEIGHTS_DIR", "/models");
+    ScopedEnv weights("IESRGS_WEIGHTS_DIR", models.path().string());
     const LpipsWeights vgg = default_lpips_weights(LpipsNet::Vgg);
-    EXPECT_EQ(vgg.backbone, fs::path("/models/vgg16-397923af.pth"));
-    EXPECT_EQ(vgg.heads, fs::path("/models/lpips/v0.1/vgg.pth"));
+    EXPECT_EQ(vgg.backbone, fs::path("/cache/torch/hub/checkpoints/vgg16-397923af.pth"));
+    EXPECT_EQ(vgg.heads, models / "lpips/v0.1/vgg.pth");
+    testing::write_text(models / "vgg16-397923af.pth", "x");
+    EXPECT_EQ(default_lpips_weights(LpipsNet::Vgg).backbone, models / "vgg16-397923af.pth");
   }
   ScopedEnv no_weights("IESRGS_WEIGHTS_DIR", std::nullopt);
-  ScopedEnv torch_home("TORCH_HOME", "/cache/torch");
   const LpipsWeights alex = default_lpips_weights(LpipsNet::Alex);
   EXPECT_EQ(alex.backbone, fs::path("/cache/torch/hub/checkpoints/alexnet-owt-7be5be79.pth"));
-  EXPECT_EQ(alex.heads, fs::path("../shared/data/weights/lpips/v0.1/alex.pth"));
+  // The development data's copy, found from any working directory.
+  EXPECT_EQ(alex.heads, priors::sr::default_weights_dir() / "lpips/v0.1/alex.pth");
+  EXPECT_TRUE(alex.heads.is_absolute()) << alex.heads;
 }
 
 TEST(Lpips, UnavailableReasonNamesTheMissingFile) {
