@@ -510,7 +510,6 @@ RunResult Pipeline::run() {
   const auto start = std::chrono::steady_clock::now();
   if (o_.only == StageSelection::Fusion) check_cached_inputs();
   if (o_.only != StageSelection::Internal) run_external_stages();
-  if (o_.only == StageSelection::External) return {{}, stages_, {}};
   if (rows_use_internal_references() || o_.only == StageSelection::Internal) run_internal_stage();
   if (o_.only == StageSelection::Internal) return {{}, stages_, {}};
 

@@ -18,13 +18,15 @@
 
 namespace iesrgs::pipeline {
 
-enum class StageSelection { All, External, Internal, Fusion };
+// What `iesrgs run`, `internal` and `fuse` run.
+enum class StageSelection { All, Internal, Fusion };
 
 struct RunOptions {
   std::filesystem::path scene;
-  // downscale: the HR resolution the scene is evaluated at; the LR input is `scale` times
-  // smaller (bicubic, as the protocol says). With input_is_lr the scene's images are the LR input
-  // themselves, nothing is evaluated and the test views are still rendered at HR.
+  // downscale: the HR resolution the scene is evaluated at; the LR input is the scene at a
+  // `scale` times larger downscale (a bicubic resize, or the capture's own downscaled images). With
+  // input_is_lr the scene's images are the LR input themselves, nothing is evaluated and the test
+  // views are still rendered at HR.
   SceneOptions scene_options;
   bool input_is_lr = false;
   int scale = 4;
@@ -44,7 +46,7 @@ struct RunOptions {
 // Row names in table order, with the groups "demo" (bicubic, internal, external, ie-srgs),
 // "ablation" and "all" expanded. Throws Error for an unknown name.
 std::vector<std::string> expand_rows(const std::vector<std::string>& names);
-// "name: what it is" for every row, for --help.
+// "name (what it is)" for every row, and the groups, for --help.
 std::string describe_rows();
 
 struct RowResult {

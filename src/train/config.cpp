@@ -74,7 +74,7 @@ TrainConfig make_preset(const std::string& name, int64_t iterations) {
   config.preset = name;
   if (name == "cpu") {
     // A third of the paper's schedule keeps densification's rhythm and reaches most of the
-    // quality on two cores; MVGS's K = 3 makes up for the shorter run.
+    // quality on two cores.
     rescale_schedule(config, 10000);
     config.test_every = 1000;
   } else if (name == "fast") {
@@ -130,6 +130,10 @@ void apply_assignment(TrainConfig& config, const std::string& assignment) {
   const size_t eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0) fail("--set \"{}\": expected key=value", assignment);
   const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  // The preset names where the schedule came from; setting the name alone would mislabel it.
+  if (key == "preset")
+    fail("--set \"{}\": the preset is chosen with --preset, which also sets its schedule",
+         assignment);
   nlohmann::json value = nlohmann::json::parse(text, nullptr, false);
   if (value.is_discarded()) value = text;
   apply_json(config, nlohmann::json{{key, value}}, "--set " + assignment);

@@ -47,16 +47,19 @@ struct TrainConfig {
   int64_t checkpoint_every = 1000;
   int64_t test_every = 1000;  // iterations between test PSNR reports; 0 = never
   int test_views = 10;        // test views in those reports (evenly spaced); 0 = all
-  int64_t log_every = 10;
+  int64_t log_every = 10;     // iterations between train_log.csv rows (test reports and the
+                              // last iteration always get one)
 };
 
-// A built-in preset: "paper" (METHOD.md's 30k-iteration schedule, for GPUs), or "cpu" and "fast",
-// which keep the algorithm and shorten the schedule to 10k and 3k iterations. The preset, with its
-// schedule (densification window, opacity reset, SH steps, position decay) rescaled to `iterations`
-// when that is positive. Throws Error for an unknown name.
+// A built-in preset: "paper" (the 30k-iteration schedule of 3DGS and Mip-Splatting, for GPUs), or
+// "cpu" and "fast", which keep the algorithm and shorten the schedule to 10k and 3k iterations. The
+// preset, with its schedule (densification window, opacity reset, SH steps, position decay)
+// rescaled to `iterations` when that is positive. Throws Error for an unknown name.
 TrainConfig make_preset(const std::string& name, int64_t iterations = 0);
 
-// Rescales every iteration count of the schedule so that it spans `iterations`.
+// Rescales the schedule (densification window, opacity resets, SH steps, position decay) so that
+// it spans `iterations`; the intervals of densification, the 3D filter, checkpoints and test
+// reports stay.
 void rescale_schedule(TrainConfig& config, int64_t iterations);
 
 nlohmann::json to_json(const TrainConfig& config);

@@ -36,9 +36,10 @@ std::string log_until(const std::filesystem::path& csv, int64_t last_iteration) 
 }  // namespace
 
 ProgressLog::ProgressLog(const std::filesystem::path& csv, int64_t first_iteration,
-                         int64_t total_iterations, double seconds_before)
+                         int64_t total_iterations, int64_t log_every, double seconds_before)
     : first_iteration_(first_iteration),
       total_iterations_(total_iterations),
+      log_every_(log_every),
       seconds_before_(seconds_before),
       start_(Clock::now()),
       last_print_(start_),
@@ -60,9 +61,11 @@ void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
                        : kLossSmoothing * smoothed_loss_ + (1 - kLossSmoothing) * loss;
   const Clock::time_point now = Clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
-  csv_ << iteration << ',' << loss << ',' << gaussians << ',' << seconds_before_ + elapsed << ',';
-  if (test_psnr) csv_ << *test_psnr;
-  csv_ << '\n';
+  if (force || test_psnr || iteration % log_every_ == 0) {
+    csv_ << iteration << ',' << loss << ',' << gaussians << ',' << seconds_before_ + elapsed << ',';
+    if (test_psnr) csv_ << *test_psnr;
+    csv_ << '\n';
+  }
   const double since_print = std::chrono::duration<double>(now - last_print_).count();
   if (!force && !test_psnr && since_print < kPrintSeconds) return;
   csv_.flush();

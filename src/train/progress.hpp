@@ -13,22 +13,23 @@ namespace iesrgs::train {
 class ProgressLog {
  public:
   // Starts `csv` afresh, or, for a run resumed after `first_iteration` that had trained for
-  // `seconds_before`, continues it from that iteration's row: rows logged after the checkpoint,
-  // or cut off by a killed process, are dropped first.
+  // `seconds_before`, continues it after that iteration: rows logged after the checkpoint, or cut
+  // off by a killed process, are dropped first.
   ProgressLog(const std::filesystem::path& csv, int64_t first_iteration, int64_t total_iterations,
-              double seconds_before);
+              int64_t log_every, double seconds_before);
 
-  // Prints when `force`, when a test PSNR came in, or when enough time has passed.
+  // Logs a row every `log_every` iterations, and prints a line, when `force` or a test PSNR came
+  // in; prints also when enough time has passed.
   void record(int64_t iteration, double loss, int64_t gaussians, std::optional<double> test_psnr,
               bool force);
 
-  // Writes the rows recorded so far: a checkpoint's iteration is then always in the file.
+  // Writes the rows recorded so far: those up to a checkpoint's iteration are then in the file.
   void flush();
 
  private:
   using Clock = std::chrono::steady_clock;
   std::ofstream csv_;
-  int64_t first_iteration_, total_iterations_;
+  int64_t first_iteration_, total_iterations_, log_every_;
   double seconds_before_;
   Clock::time_point start_, last_print_;
   int64_t last_print_iteration_;

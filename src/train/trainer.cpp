@@ -80,7 +80,7 @@ bool all_finite(const gs::GaussianModel& model) {
 }
 
 // Parameters, gradients, Adam moments, densification statistics and the per-view projection
-// buffers: the peak resident memory grows by about 1.4 KB per Gaussian (measured from 0.1M to 3M
+// buffers: the peak resident memory grows by about 1.4 KB per Gaussian (measured from 0.1M to 1M
 // random points).
 constexpr int64_t kBytesPerGaussian = 1400;
 
@@ -335,7 +335,7 @@ TrainSummary Trainer::run() {
   InterruptScope interrupt_scope;
   TrainSummary summary;
   ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations,
-                  seconds_before_);
+                  config_.log_every, seconds_before_);
   write_cameras_json(cameras_path(), train_cameras_);
   run_start_ = std::chrono::steady_clock::now();
   while (iteration_ < config_.iterations) {
@@ -354,8 +354,8 @@ TrainSummary Trainer::run() {
     }
     // After the report: an opacity reset on the same iteration would make it read ~12 dB.
     densify(iteration_);
-    log.record(iteration_, last_loss_, model_.size(), test_psnr, last);
     const bool interrupted = interrupt_requested.load();
+    log.record(iteration_, last_loss_, model_.size(), test_psnr, last || interrupted);
     if (last || interrupted ||
         (config_.checkpoint_every > 0 && iteration_ % config_.checkpoint_every == 0)) {
       log.flush();  // first: a resume keeps the rows up to its checkpoint and drops the rest

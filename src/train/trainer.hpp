@@ -51,7 +51,7 @@ void require_training_memory(int64_t gaussians, torch::Device device);
 
 struct TrainSummary {
   int64_t iterations = 0;            // completed in total (including before a resume)
-  bool interrupted = false;          // stopped by SIGINT after saving a checkpoint
+  bool interrupted = false;          // stopped by SIGINT or SIGTERM after saving a checkpoint
   double seconds = 0;                // of training, the runs before a resume included
   double iterations_per_second = 0;  // iterations / seconds
   double final_loss = 0;
@@ -73,8 +73,9 @@ class Trainer {
   static Trainer resumed(const TrainConfig& config, TrainerSetup setup);
 
   // Trains to config.iterations, printing progress; checkpoints every config.checkpoint_every
-  // iterations and when SIGINT arrives (then returns with summary.interrupted). Throws Error when
-  // the loss or the parameters stop being finite; the last good checkpoint stays on disk.
+  // iterations and when SIGINT or SIGTERM arrives (then returns with summary.interrupted). Throws
+  // Error when the loss or the parameters stop being finite; the last good checkpoint stays on
+  // disk.
   TrainSummary run();
 
   // On the training device (core/device.hpp).

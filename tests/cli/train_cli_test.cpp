@@ -166,7 +166,7 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   // A new run into the folder replaces the earlier one whole: no checkpoint of it is left for a
   // --resume to continue under the new config, and the log starts again.
   ASSERT_EQ(iesrgs(train + " --preset fast --iterations 5 --set random_points=500").status, 0);
-  EXPECT_EQ(read_file(dir / "run" / "train_log.csv").find("\n6,"), std::string::npos);
+  EXPECT_EQ(read_file(dir / "run" / "train_log.csv").find("\n10,"), std::string::npos);
   EXPECT_EQ(nlohmann::json::parse(read_file(dir / "run" / "training.json"))["iterations"], 5);
 }
 
@@ -207,6 +207,11 @@ TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {
   const CliRun none = iesrgs("train " + scene + " -o " + (dir / "c").string() + " --iterations 0");
   EXPECT_NE(none.status, 0);
   EXPECT_TRUE(contains(none.output, "--iterations: must be greater than 0, got 0")) << none.output;
+  const CliRun bright = iesrgs("train " + scene + " -o " + (dir / "c").string() +
+                               " --background 2,0,0.5");
+  EXPECT_EQ(bright.status, 1);
+  EXPECT_TRUE(contains(last_line(bright.output), "each of r,g,b must be in [0, 1], got '2,0,0.5'"))
+      << bright.output;
   const CliRun huge = iesrgs("train " + scene + " -o " + (dir / "c").string() +
                              " --set init=random --set random_points=2000000000");
   EXPECT_EQ(huge.status, 1);

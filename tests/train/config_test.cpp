@@ -72,6 +72,9 @@ TEST(TrainConfig, BadInputNamesTheProblem) {
             std::string::npos);
   EXPECT_NE(error_message([&] { apply_assignment(c, "novalue"); }).find("key=value"),
             std::string::npos);
+  // The preset is a record of where the schedule came from, set with --preset.
+  EXPECT_NE(error_message([&] { apply_assignment(c, "preset=paper"); }).find("--preset"),
+            std::string::npos);
   EXPECT_NE(error_message([] { make_preset("turbo"); }).find("turbo"), std::string::npos);
   c.views_per_iteration = 0;
   EXPECT_NE(error_message([&] { validate(c); }).find("views_per_iteration"), std::string::npos);

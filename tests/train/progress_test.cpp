@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -52,7 +54,7 @@ TEST(Progress, AResumedLogContinuesFromItsCheckpoint) {
                         "iteration,loss,gaussians,elapsed_seconds,test_psnr\n"
                         "1,0.5,10,0.1,\n2,0.4,10,0.2,\n3,0.3,10,0.3,\n4,0.2,1");
   {
-    ProgressLog log(csv, 2, 10, 5.0);
+    ProgressLog log(csv, 2, 10, 1, 5.0);
     log.record(3, 0.25, 12, std::nullopt, false);
   }
   const std::vector<std::string> resumed = lines_of(csv);
@@ -61,8 +63,22 @@ TEST(Progress, AResumedLogContinuesFromItsCheckpoint) {
   EXPECT_EQ(resumed[3].rfind("3,0.25,12,", 0), 0u) << resumed[3];
   EXPECT_GE(std::stod(resumed[3].substr(std::string("3,0.25,12,").size())), 5.0);
 
-  { ProgressLog fresh(csv, 0, 10, 0.0); }  // a new run starts the log again
+  { ProgressLog fresh(csv, 0, 10, 1, 0.0); }  // a new run starts the log again
   EXPECT_EQ(lines_of(csv).size(), 1u);
+}
+
+// Rows every log_every iterations, and whenever a test PSNR comes in or the caller forces one.
+TEST(Progress, LogsEveryLogEveryIterations) {
+  testing::TempDir dir;
+  const auto csv = dir / "train_log.csv";
+  {
+    ProgressLog log(csv, 0, 12, 5, 0.0);
+    for (int64_t i = 1; i <= 12; ++i)
+      log.record(i, 0.5, 10, i == 7 ? std::optional<double>(20.0) : std::nullopt, i == 12);
+  }
+  std::vector<int> iterations;
+  for (const std::string& row : lines_of(csv)) iterations.push_back(std::atoi(row.c_str()));
+  EXPECT_EQ(iterations, (std::vector<int>{0, 5, 7, 10, 12}));  // the header reads as 0
 }
 
 }  // namespace
