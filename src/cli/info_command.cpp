@@ -126,7 +126,9 @@ void add_info_command(CLI::App& app) {
                          "run folder's results");
   auto args = std::make_shared<SceneArgs>();
   auto load_images = std::make_shared<bool>(false);
-  args->add_to(*command);
+  args->add_to(*command, std::string(SceneArgs::kSceneHelp) +
+                             "; or a model (a training folder, .ply, .spz, .splat) or a run "
+                             "folder of iesrgs run");
   command->add_flag("--load-images", *load_images,
                     "Also decode every image (undistorted and resized as training would) and "
                     "fail on the first bad one");

@@ -5,13 +5,8 @@
 
 namespace iesrgs::cli {
 
-void SceneArgs::add_to(CLI::App& command) {
-  command
-      .add_option("scene", path,
-                  "Scene: a folder with transforms_train.json (NeRF Synthetic), "
-                  "transforms.json (nerfstudio / instant-ngp) or sparse/0 (COLMAP), "
-                  "or a transforms.json file")
-      ->required();
+void SceneArgs::add_to(CLI::App& command, const std::string& what) {
+  command.add_option("scene", path, what)->required();
   command
       .add_option("--downscale", options.downscale,
                   "Load images at 1/k resolution: <images>_<k>/ when present, else a "
@@ -40,6 +35,9 @@ SceneOptions SceneArgs::resolved() const {
     char tail;
     if (std::sscanf(background.c_str(), "%f,%f,%f%c", &r, &g, &b, &tail) != 3)
       fail("--background: expected white, black or r,g,b, got '{}'", background);
+    for (float channel : {r, g, b})
+      if (!(channel >= 0 && channel <= 1))
+        fail("--background: each of r,g,b must be in [0, 1], got '{}'", background);
     resolved.background = {r, g, b};
   }
   return resolved;

@@ -13,8 +13,13 @@ struct SceneArgs {
   SceneOptions options;
   std::string background = "white";
 
-  // Registers the positional scene path and the loading options on `command`.
-  void add_to(CLI::App& command);
+  // Registers the positional scene path (described by `what`, the scene formats by default) and
+  // the loading options on `command`.
+  void add_to(CLI::App& command, const std::string& what = kSceneHelp);
+
+  static constexpr const char* kSceneHelp =
+      "Scene: a folder with transforms_train.json (NeRF Synthetic), transforms.json (nerfstudio / "
+      "instant-ngp) or sparse/0 (COLMAP), or a transforms.json file";
   // Validated SceneOptions (parses --background).
   SceneOptions resolved() const;
 };

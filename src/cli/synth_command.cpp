@@ -21,7 +21,10 @@ void add_synth_command(CLI::App& app) {
   command->add_option("-o,--output", *output, "Directory to write the scene into")->required();
   command->add_option("--size", options->size, "Image width and height in pixels")
       ->capture_default_str();
-  command->add_option("--views", options->train_views, "Training views (upper hemisphere)")
+  command
+      ->add_option("--views", options->train_views,
+                   "Training views (upper hemisphere); with --format colmap, the views and "
+                   "test views make one capture, of which every 8th image is held out")
       ->capture_default_str();
   command->add_option("--test-views", options->test_views, "Test views (a spiral between them)")
       ->capture_default_str();
@@ -37,7 +40,7 @@ void add_synth_command(CLI::App& app) {
                    "blender: NeRF-Synthetic layout with separate test views; colmap: images/ "
                    "and sparse/0 with surface points as SfM points, every 8th image held out")
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case))
-      ->capture_default_str();
+      ->default_str("blender");
   command->callback([output, options] {
     const auto start = std::chrono::steady_clock::now();
     synth::write_synth_dataset(*output, *options, [](int done, int total) {

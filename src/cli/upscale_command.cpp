@@ -111,9 +111,10 @@ void add_upscale_command(CLI::App& app) {
   command->add_option("--model", args->model, "Backend: " + models)->required();
   command
       ->add_option("--weights", args->weights,
-                   "Checkpoint (.pth), or package folder for esrgan-*; default "
-                   "<weights dir>/sr/<MODEL>_x<scale>.pth, the weights dir being "
-                   "$IESRGS_WEIGHTS_DIR or the development data")
+                   "Checkpoint (.pth), or package folder for esrgan-*; default for safmn, "
+                   "imdn and pan <weights dir>/sr/<MODEL>_x<scale>.pth, the weights dir being "
+                   "$IESRGS_WEIGHTS_DIR or the development data, for esrgan-* the npm package "
+                   "setup installs; swinir needs one, bicubic takes none")
       ->check(CLI::ExistingPath);
   command->add_option("--scale", args->scale, "Upscaling factor")->capture_default_str();
   command
