@@ -59,8 +59,16 @@ void ssim_sizes(benchmark::internal::Benchmark* b) {
     for (int threads : {1, 2}) b->Args({side, threads});
 }
 
-BENCHMARK(BM_SsimForward)->Apply(ssim_sizes)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_SsimForwardBackward)->Apply(ssim_sizes)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SsimForward)
+    ->Apply(ssim_sizes)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
+BENCHMARK(BM_SsimForwardBackward)
+    ->Apply(ssim_sizes)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 // A mask like IE-SRGS's M on lego at x4: thin broken outlines (every 4th pixel of a dozen circles
 // in the middle of the view), about 0.5 % of the pixels.
@@ -101,7 +109,8 @@ BENCHMARK(BM_GuidedTexture)
     ->ArgNames({"side", "threads", "masked"})
     ->ArgsProduct({{400, 800}, {1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 // The internal depth term of a fusion step with its gradients, as the hand-written kernel
 // (`ops:0`) or as the tensor ops that GPUs run (`ops:1`), at 400x400: a render covering about
@@ -129,7 +138,8 @@ BENCHMARK(BM_InternalDepthTerm)
     ->Arg(0)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace iesrgs::loss

@@ -30,7 +30,8 @@ BENCHMARK(BM_StartingScales)
     ->ArgNames({"points", "outlier", "threads"})
     ->ArgsProduct({{100000}, {0, 100}, {2}})
     ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace iesrgs::gs

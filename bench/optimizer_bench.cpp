@@ -41,12 +41,14 @@ BENCHMARK(BM_AdamStep)
     ->ArgNames({"gaussians", "threads"})
     ->ArgsProduct({{100000, 500000}, {1, 2}})
     ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 BENCHMARK(BM_DensifyStatistics)
     ->ArgNames({"gaussians", "views", "threads"})
     ->ArgsProduct({{100000}, {1, 3}, {1, 2}})
     ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace iesrgs::gs

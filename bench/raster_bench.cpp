@@ -69,12 +69,14 @@ BENCHMARK(BM_RasterForward)
     ->Args({100000, 800, 1})
     ->Args({100000, 800, 2})
     ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 BENCHMARK(BM_RasterForwardBackward)
     ->Args({100000, 800, 1})
     ->Args({100000, 800, 2})
     ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace iesrgs::raster

@@ -1,8 +1,11 @@
 #include <benchmark/benchmark.h>
 
+#include <omp.h>
+
 #include <cstdint>
 
 #include "io/resize.hpp"
+#include "machine_threads.hpp"
 
 namespace iesrgs {
 namespace {
@@ -16,6 +19,7 @@ Image8 pattern(int width, int height, int channels) {
 
 void resize_case(benchmark::State& state, int width, int height, int channels, int out_width,
                  int out_height) {
+  omp_set_num_threads(int(state.range(0)));
   const Image8 source = pattern(width, height, channels);
   for (auto _ : state) benchmark::DoNotOptimize(resize_bicubic(source, out_width, out_height));
   state.SetItemsProcessed(state.iterations() * int64_t(width) * height);
@@ -34,9 +38,21 @@ void BM_ResizeRgba200To800(benchmark::State& state) {
   resize_case(state, 200, 200, 4, 800, 800);
 }
 
-BENCHMARK(BM_ResizeRgba800To200)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_ResizeRgb1080x1920To540x960)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_ResizeRgba200To800)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ResizeRgba800To200)
+    ->Apply(machine_threads)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
+BENCHMARK(BM_ResizeRgb1080x1920To540x960)
+    ->Apply(machine_threads)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
+BENCHMARK(BM_ResizeRgba200To800)
+    ->Apply(machine_threads)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace iesrgs

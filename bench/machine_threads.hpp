@@ -1,0 +1,14 @@
+#pragma once
+// For benchmarks that run on every thread: names the count, and sets it for each run, since an
+// earlier benchmark may have left OpenMP and LibTorch at another.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+namespace iesrgs {
+
+// Registers the argument "threads": OMP_NUM_THREADS, or every core.
+inline void machine_threads(benchmark::internal::Benchmark* b) {
+  b->ArgName("threads")->Arg(omp_get_max_threads());
+}
+
+}  // namespace iesrgs
