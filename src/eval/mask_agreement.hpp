@@ -4,8 +4,9 @@
 // the HR ground truth gives, G = [D(truth, E_image) >= T], and whether the internal image is in
 // fact the closer reference where M picks it; and how close each reference is to the truth:
 // E_image, I_image, the fused reference the mask-guided loss pulls towards (I_image on M,
-// E_image elsewhere) and the best reference any mask could give (the oracle mask: I_image
-// wherever it is the closer one). Benchmarks only: it needs the HR training views.
+// E_image elsewhere) and the best reference a mask could give by the L1 the loss trains with (the
+// oracle mask: I_image wherever its absolute error is the smaller). Benchmarks only: it needs the
+// HR training views.
 #include <torch/types.h>
 
 #include <cstdint>
@@ -32,7 +33,8 @@ struct MaskCounts {
   double iou() const { return share(both, mask + truth_mask - both); }
   double internal_closer_share() const { return share(internal_closer, mask); }
   double oracle_mask_share() const { return share(closer, pixels); }
-  // PSNR of each reference over all pixels and channels.
+  // PSNR of each reference over all pixels and channels of every view pooled: never above the
+  // mean of per-view PSNRs that eval reports for renders, and below it where views differ.
   double external_psnr() const { return psnr(external_error); }
   double internal_psnr() const { return psnr(internal_error); }
   double fused_psnr() const { return psnr(fused_error); }
