@@ -5,6 +5,8 @@
 
 #include <algorithm>
 
+#include <nlohmann/json.hpp>
+
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
 #include "cli/validators.hpp"
@@ -12,6 +14,7 @@
 #include "core/paths.hpp"
 #include "eval/lpips.hpp"
 #include "eval/metrics.hpp"
+#include "io/atomic_file.hpp"
 #include "io/scene.hpp"
 #include "io/view_images.hpp"
 #include "pipeline/evaluate.hpp"
@@ -41,6 +44,26 @@ std::vector<std::filesystem::path> render_files(std::filesystem::path dir) {
   std::sort(files.begin(), files.end());
   if (files.empty()) fail_file(dir, "holds no PNG or JPEG images");
   return files;
+}
+
+// Refuses renders that `iesrgs render` made of other cameras than the ground truth's split, as
+// its render.json records them: names alone do not tell (NeRF Synthetic's splits both start at
+// r_0).
+void check_rendered_split(const EvalArgs& args) {
+  std::filesystem::path folder = args.renders;
+  if (folder.filename() == "rgb" && !std::filesystem::exists(folder / "render.json"))
+    folder = folder.parent_path();
+  const std::filesystem::path record = folder / "render.json";
+  if (!is_scene(args.ground_truth) || !std::filesystem::exists(record)) return;
+  const nlohmann::json report = nlohmann::json::parse(read_file(record), nullptr, false);
+  if (!report.is_object()) return;
+  if (report.contains("path"))
+    fail_file(record, "these renders are frames of a camera path, which have no ground truth");
+  const std::string split = report.value("split", args.split);
+  if (split != args.split)
+    fail_file(record, fmt::format("these renders are of the {} split, and --split {} would score "
+                                  "them against other views of the same names; use --split {}",
+                                  split, args.split, split));
 }
 
 // Ground truth for a render stem: a scene's camera of that name (at --downscale, composited over
@@ -96,6 +119,7 @@ class GroundTruth {
 };
 
 void run_eval(const EvalArgs& args) {
+  check_rendered_split(args);
   SceneArgs scene_args;
   scene_args.options.downscale = args.downscale;
   scene_args.background = args.background;

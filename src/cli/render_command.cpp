@@ -26,6 +26,9 @@ namespace iesrgs::cli {
 
 namespace {
 
+// An hour at 30 frames per second; every frame's camera is made before the first renders.
+constexpr int kMostFrames = 108000;
+
 struct RenderArgs {
   std::string model;
   SceneArgs scene;
@@ -38,16 +41,23 @@ struct RenderArgs {
   std::string device = "auto";
 };
 
+// Whether `name` stays inside the folder it is joined to (a COLMAP view's name may hold folders).
+bool inside_folder(const std::string& name) {
+  const std::filesystem::path path(name);
+  if (name.empty() || path.has_root_path()) return false;
+  return std::none_of(path.begin(), path.end(), [](const auto& part) { return part == ".."; });
+}
+
 // The views an earlier render listed in the folder's render.json that this one, of the views
 // `names`, does not make (fewer path frames, another split): they would mix with its own. Only
-// files that render wrote.
+// files that render wrote, and none outside the folder whatever render.json says.
 void remove_earlier_views(const std::filesystem::path& dir, const std::vector<std::string>& names) {
   const std::filesystem::path report = dir / "render.json";
   if (!std::filesystem::exists(report)) return;
   const nlohmann::json earlier = nlohmann::json::parse(read_file(report), nullptr, false);
   if (!earlier.is_object() || !earlier.contains("names") || !earlier["names"].is_array()) return;
   for (const nlohmann::json& name : earlier["names"]) {
-    if (!name.is_string() ||
+    if (!name.is_string() || !inside_folder(name.get<std::string>()) ||
         std::find(names.begin(), names.end(), name.get<std::string>()) != names.end())
       continue;
     const std::string view = name.get<std::string>();
@@ -96,14 +106,19 @@ void run_render(const RenderArgs& args) {
   remove_earlier_views(args.output, names);
   const double seconds =
       pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
-  const nlohmann::json report = {{"views", cameras.size()},
-                                 {"width", first.intrinsics.width},
-                                 {"height", first.intrinsics.height},
-                                 {"gaussians", model.size()},
-                                 {"rasterize_mode", mode},
-                                 {"seconds_per_view", seconds},
-                                 {"fps", seconds > 0 ? 1.0 / seconds : 0.0},
-                                 {"names", names}};
+  nlohmann::json report = {{"views", cameras.size()},
+                           {"width", first.intrinsics.width},
+                           {"height", first.intrinsics.height},
+                           {"gaussians", model.size()},
+                           {"rasterize_mode", mode},
+                           {"seconds_per_view", seconds},
+                           {"fps", seconds > 0 ? 1.0 / seconds : 0.0},
+                           {"names", names}};
+  // What eval checks its ground truth against.
+  if (args.path.empty())
+    report["split"] = args.split;
+  else
+    report["path"] = args.path;
   write_file_atomically(std::filesystem::path(args.output) / "render.json", report.dump(2) + "\n");
   fmt::print("{:.1f} ms per view ({:.1f} FPS); wrote {}\n", seconds * 1e3,
              seconds > 0 ? 1.0 / seconds : 0.0, args.output);
@@ -134,7 +149,7 @@ void add_render_command(CLI::App& app) {
                    "training cameras in order")
       ->check(CLI::IsMember({"orbit", "interp"}));
   command->add_option("--frames", args->frames, "Frames of --path")
-      ->check(kPositive)
+      ->check(CLI::Range(1, kMostFrames))
       ->capture_default_str();
   command
       ->add_option("--rasterize-mode", args->rasterize_mode,
