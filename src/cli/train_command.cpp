@@ -103,20 +103,24 @@ void run_train(const TrainArgs& args) {
   if (summary.interrupted) throw Interrupted("continue with the same command and --resume");
   train::write_point_clouds(out, trainer.model());
 
-  const nlohmann::json report = {{"scene", scene.root.string()},
-                                 {"downscale", scene.downscale},
-                                 {"width", width},
-                                 {"height", height},
-                                 {"iterations", summary.iterations},
-                                 {"seconds", summary.seconds},
-                                 {"iterations_per_second", summary.iterations_per_second},
-                                 {"gaussians", summary.gaussians},
-                                 {"final_loss", summary.final_loss},
-                                 {"test_psnr", summary.test_psnr},
-                                 {"peak_memory_mib", double(peak_memory_bytes()) / (1 << 20)}};
+  const nlohmann::json report = {
+      {"scene", scene.root.string()},
+      {"downscale", scene.downscale},
+      {"width", width},
+      {"height", height},
+      {"iterations", summary.iterations},
+      {"seconds", summary.seconds},
+      {"iterations_per_second", summary.iterations_per_second},
+      {"gaussians", summary.gaussians},
+      {"final_loss", summary.final_loss},
+      {"test_psnr", summary.test_psnr ? nlohmann::json(*summary.test_psnr) : nlohmann::json()},
+      {"peak_memory_mib", double(peak_memory_bytes()) / (1 << 20)}};
   write_file_atomically(out / "training.json", report.dump(2) + "\n");
-  fmt::print("done: {} Gaussians, {:.2f} it/s, test PSNR {:.2f} dB; wrote {}\n", summary.gaussians,
-             summary.iterations_per_second, summary.test_psnr, (out / "point_cloud.ply").string());
+  fmt::print("done: {} Gaussians, {:.2f} it/s, {}; wrote {}\n", summary.gaussians,
+             summary.iterations_per_second,
+             summary.test_psnr ? fmt::format("test PSNR {:.2f} dB", *summary.test_psnr)
+                               : std::string("no test views scored"),
+             (out / "point_cloud.ply").string());
 }
 
 }  // namespace

@@ -31,6 +31,9 @@ namespace iesrgs::train {
 
 namespace {
 
+// A checkpoint's test PSNR when no test report was made.
+constexpr double kNoReport = std::numeric_limits<double>::quiet_NaN();
+
 std::atomic<bool> interrupt_requested{false};
 
 extern "C" void request_interrupt(int signal) {
@@ -138,14 +141,15 @@ void Trainer::save_checkpoint() {
     std::lock_guard<std::mutex> lock(generator.mutex());
     torch_rng = generator.get_state();
   }
-  gs::save_training_state(checkpoint_path(), model_, *optimizer_, stats_,
-                          {{"iteration", torch::tensor(iteration_)},
-                           {"view_rng", bytes_tensor(view_rng.str())},
-                           {"torch_rng", torch_rng},
-                           {"seconds", torch::tensor(training_seconds(), torch::kFloat64)},
-                           {"loss", torch::tensor(last_loss_, torch::kFloat64)},
-                           {"test_psnr", torch::tensor(last_test_psnr_, torch::kFloat64)},
-                           {"background", background_tensor()}});
+  gs::save_training_state(
+      checkpoint_path(), model_, *optimizer_, stats_,
+      {{"iteration", torch::tensor(iteration_)},
+       {"view_rng", bytes_tensor(view_rng.str())},
+       {"torch_rng", torch_rng},
+       {"seconds", torch::tensor(training_seconds(), torch::kFloat64)},
+       {"loss", torch::tensor(last_loss_, torch::kFloat64)},
+       {"test_psnr", torch::tensor(last_test_psnr_.value_or(kNoReport), torch::kFloat64)},
+       {"background", background_tensor()}});
   checkpoint_iteration_ = iteration_;
 }
 
@@ -190,7 +194,8 @@ void Trainer::load_checkpoint() {
   };
   seconds_before_ = stored("seconds");
   last_loss_ = stored("loss");
-  last_test_psnr_ = stored("test_psnr");
+  if (const double psnr = stored("test_psnr"); extras["test_psnr"].defined() && !std::isnan(psnr))
+    last_test_psnr_ = psnr;
   std::istringstream view_rng(tensor_bytes(extras["view_rng"]));
   view_rng >> view_rng_;
   if (!view_rng) fail_file(path, "the stored view sampler state is corrupt");
@@ -350,7 +355,7 @@ TrainSummary Trainer::run() {
     if (!setup_.test_views.empty() && config_.test_every > 0 &&
         (iteration_ % config_.test_every == 0 || last)) {
       test_psnr = report_test_psnr();
-      last_test_psnr_ = *test_psnr;
+      last_test_psnr_ = test_psnr;
     }
     // After the report: an opacity reset on the same iteration would make it read ~12 dB.
     densify(iteration_);

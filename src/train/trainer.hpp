@@ -55,7 +55,7 @@ struct TrainSummary {
   double seconds = 0;                // of training, the runs before a resume included
   double iterations_per_second = 0;  // iterations / seconds
   double final_loss = 0;
-  double test_psnr = 0;  // last report; 0 without test views
+  std::optional<double> test_psnr;  // the last report; none without test views or reports
   int64_t gaussians = 0;
 };
 
@@ -117,7 +117,7 @@ class Trainer {
   // The last step's loss and test report, checkpointed so that resuming a finished run reports
   // them rather than zeros.
   double last_loss_ = 0;
-  double last_test_psnr_ = 0;
+  std::optional<double> last_test_psnr_;
   bool memory_capped_ = false;  // densification was held back for memory (warned once)
   std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now();
 };

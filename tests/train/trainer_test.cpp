@@ -102,6 +102,7 @@ TEST_F(TrainerTest, FittingRaisesTestPsnrAndDensifies) {
   const int64_t start_size = trainer.model().size();
   const TrainSummary summary = trainer.run();
   EXPECT_EQ(summary.iterations, 40);
+  EXPECT_FALSE(summary.test_psnr.has_value());  // test_every 0: no report, not a PSNR of 0
   EXPECT_GT(trainer.evaluate_psnr(test), before + 3) << "before " << before;
   EXPECT_NE(trainer.model().size(), start_size);
   EXPECT_TRUE(std::filesystem::exists(trainer.checkpoint_path()));  // the last iteration's
