@@ -3,6 +3,9 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
 
 #include "core/error.hpp"
 
@@ -60,6 +63,14 @@ void read_field(const nlohmann::json& value, T& field, const std::string& key,
                   : std::is_unsigned_v<T>          ? value.is_number_unsigned()
                                                    : value.is_number_integer();
   if (!ok) fail("{}: \"{}\" has the wrong type ({})", origin, key, value.dump());
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    // JSON integers are 64-bit: a larger one than the field holds would wrap around.
+    const bool fits = value.is_number_unsigned()
+                          ? value.get<uint64_t>() <= uint64_t(std::numeric_limits<T>::max())
+                          : value.get<int64_t>() >= int64_t(std::numeric_limits<T>::min()) &&
+                                value.get<int64_t>() <= int64_t(std::numeric_limits<T>::max());
+    if (!fits) fail("{}: \"{}\" is out of range ({})", origin, key, value.dump());
+  }
   field = value.get<T>();
 }
 

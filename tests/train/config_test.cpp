@@ -72,6 +72,11 @@ TEST(TrainConfig, BadInputNamesTheProblem) {
             std::string::npos);
   EXPECT_NE(error_message([&] { apply_assignment(c, "novalue"); }).find("key=value"),
             std::string::npos);
+  // 200 more than 2^32 would wrap around to 200 in the int field.
+  EXPECT_NE(error_message([&] {
+              apply_assignment(c, "random_points=4294967496");
+            }).find("\"random_points\" is out of range (4294967496)"),
+            std::string::npos);
   // The preset is a record of where the schedule came from, set with --preset.
   EXPECT_NE(error_message([&] { apply_assignment(c, "preset=paper"); }).find("--preset"),
             std::string::npos);
