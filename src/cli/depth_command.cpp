@@ -6,6 +6,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/device_option.hpp"
+#include "cli/validators.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
 #include "io/image.hpp"
@@ -63,7 +64,7 @@ void add_depth_command(CLI::App& app) {
   command
       ->add_option("--background", args->background,
                    "Gray level in [0, 1] that transparent pixels are composited over")
-      ->check(CLI::Range(0.f, 1.f))
+      ->check(kUnitInterval)
       ->capture_default_str();
   command->add_option("IN", args->in, "An image, or a folder of images")->required();
   command

@@ -26,6 +26,10 @@ void run_export(const ExportArgs& args) {
   if (format != ".splat" && format != ".spz" && format != ".ply")
     fail_file(output, "unknown export format: the name must end in .splat, .spz or .ply");
   const std::filesystem::path model = model_file(args.model);
+  std::error_code ec;  // set, and false returned, when the output does not exist yet
+  // A baked copy over a Mip-Splatting model would lose its 3D filter for good.
+  if (std::filesystem::equivalent(model, output, ec))
+    fail_file(output, "is the model being exported; write the export elsewhere");
   const SplatCloud cloud = read_model(model);
   // An empty .splat is an empty file, which no reader can tell from a damaged one.
   if (cloud.size() == 0) fail_file(model, "holds no Gaussians: nothing to export");

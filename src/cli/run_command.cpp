@@ -101,7 +101,7 @@ CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
       ->check(kNonNegative);
   command->add_option("--dssim", o.weights.dssim_weight, "D-SSIM weight l of the texture loss")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(kUnitInterval);
   command
       ->add_option("--threshold", o.threshold,
                    "Discrepancy threshold T (default 0.6 synthetic, 0.9 real scenes)")

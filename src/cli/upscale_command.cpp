@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -52,6 +53,13 @@ std::vector<Job> folder_jobs(const fs::path& folder, const fs::path& out) {
       jobs.push_back({entry.path(), out / entry.path().stem().concat(".png")});
   if (jobs.empty()) fail_file(folder, "no PNG or JPEG images in this folder");
   std::sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.input < b.input; });
+  // a.png and a.jpg would both become a.png, the second overwriting the first.
+  std::map<fs::path, fs::path> inputs;
+  for (const Job& job : jobs)
+    if (const auto [it, added] = inputs.emplace(job.output, job.input); !added)
+      fail_file(folder, fmt::format("{} and {} would both be upscaled to {}; rename one",
+                                    it->second.filename().string(), job.input.filename().string(),
+                                    job.output.string()));
   return jobs;
 }
 
@@ -131,7 +139,7 @@ void add_upscale_command(CLI::App& app) {
       ->add_option("--background", args->background,
                    "Gray level in [0, 1] that transparent pixels are composited over")
       ->capture_default_str()
-      ->check(CLI::Range(0.f, 1.f));
+      ->check(kUnitInterval);
   command->add_option("input", args->input, "Image or folder of images")->required();
   command->add_option("output", args->output, "PNG file, or folder for a folder input")->required();
   add_device_option(*command, args->device);

@@ -23,6 +23,15 @@ inline CLI::Validator number_above(double bound, bool inclusive, const std::stri
       name);
 }
 
+// A number in [0, 1]; unlike CLI::Range, which lets NaN through.
+inline const CLI::Validator kUnitInterval(
+    [](std::string& text) -> std::string {
+      double value = 0;
+      if (CLI::detail::lexical_cast(text, value) && value >= 0 && value <= 1) return {};
+      return "must be a number in [0, 1], got " + text;
+    },
+    "IN [0, 1]");
+
 inline const CLI::Validator kPositive = number_above(0, false, "POSITIVE");
 inline const CLI::Validator kNonNegative = number_above(0, true, "NONNEGATIVE");
 

@@ -206,6 +206,25 @@ class Pipeline {
   nlohmann::json stages_ = nlohmann::json::object();
 };
 
+namespace {
+
+// The HR truth must be the LR views' size times the scale, as the HR rows are trained at and the
+// truth-masked rows compare with.
+void require_scale_divides(const Scene& hr, const Scene& lr, int scale) {
+  for (size_t i = 0; i < hr.cameras.size(); ++i) {
+    const Intrinsics &high = hr.cameras[i].intrinsics, &low = lr.cameras[i].intrinsics;
+    if (high.width == low.width * scale && high.height == low.height * scale) continue;
+    fail_file(hr.cameras[i].image_path,
+              fmt::format("at --downscale {} this view is {}x{}, which --scale {} does not divide "
+                          "(the LR view would be {}x{}, upscaled {}x{}); pick a scale or "
+                          "downscale that divides the image size",
+                          hr.downscale, high.width, high.height, scale, low.width, low.height,
+                          low.width * scale, low.height * scale));
+  }
+}
+
+}  // namespace
+
 Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(options.rows)) {
   if (o_.scale < 2) fail("--scale must be at least 2, got {}", o_.scale);
   o_.external.scale = o_.scale;
@@ -218,6 +237,7 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
     lr_options.downscale *= o_.scale;
   }
   lr_scene_ = load_scene(o_.scene, lr_options);
+  if (hr_scene_) require_scale_divides(*hr_scene_, lr_scene_, o_.scale);
   require_trainable_views(lr_scene_);
   lr_images_ = std::make_unique<ViewImages>(lr_scene_);
   threshold_ = o_.threshold >= 0     ? o_.threshold
@@ -255,7 +275,7 @@ bool Pipeline::rows_use_internal_references() const {
 
 void Pipeline::check_cached_inputs() const {
   const auto require = [](bool current, const fs::path& dir, const char* stage,
-                          const char* runners) {
+                          const std::string& runners) {
     if (!current)
       fail_file(dir, fmt::format("the {} stage here is missing, unfinished, or made from other "
                                  "images or settings than these; {} with the same scene and "
@@ -264,7 +284,8 @@ void Pipeline::check_cached_inputs() const {
   };
   if (any_row(Source::SuperResolved))
     require(external_stage_current(lr_scene_, *lr_images_, o_.external, o_.output / "external"),
-            o_.output / "external", "external", "iesrgs run");
+            o_.output / "external", "external",
+            fmt::format("iesrgs external -o {} or iesrgs run", (o_.output / "external").string()));
   if (rows_use_internal_references())
     require(internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
                                    o_.output / "internal"),

@@ -127,6 +127,18 @@ TEST(Cli, UpscaleWritesOnePngPerImageOfAFolder) {
   EXPECT_EQ(std::make_tuple(b.width, b.height, b.channels), std::make_tuple(12, 10, 3));
 }
 
+TEST(Cli, UpscaleRefusesTwoImagesOfOneStem) {
+  TempDir dir;
+  write_png(dir / "in" / "a.png", Image8(4, 4, 3));
+  write_text(dir / "in" / "a.jpg", "decoded only once the names are checked");
+  const CliRun run = iesrgs("upscale --model bicubic --scale 2 " + (dir / "in").string() + " " +
+                            (dir / "out").string());
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_TRUE(contains(last_line(run.output), "a.jpg and a.png would both be upscaled to"))
+      << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "a.png"));
+}
+
 TEST(Cli, UpscaleOfAMissingInputNamesIt) {
   TempDir dir;
   const CliRun run =
@@ -157,6 +169,24 @@ TEST(Cli, UpscaleNeverWritesOverItsInputNorPngBytesUnderAnotherName) {
   EXPECT_TRUE(contains(last_line(named.output), jpeg + ": upscale writes PNG images"))
       << named.output;
   EXPECT_FALSE(std::filesystem::exists(jpeg));
+}
+
+TEST(Cli, ExportNeverWritesOverItsModel) {
+  TempDir dir;
+  SplatCloud cloud;
+  cloud.positions = {0, 0, 0};
+  cloud.sh_dc = {0.5f, 0.5f, 0.5f};
+  cloud.opacity = {0};
+  cloud.log_scales = {-2, -2, -2};
+  cloud.rotations = {1, 0, 0, 0};
+  write_ply(dir / "model.ply", cloud);
+  const std::string before = read_file(dir / "model.ply");
+  const std::string model = (dir / "model.ply").string();
+  const CliRun run = iesrgs("export " + model + " " + model);
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_EQ(last_line(run.output),
+            "error: " + model + ": is the model being exported; write the export elsewhere");
+  EXPECT_EQ(read_file(dir / "model.ply"), before);
 }
 
 TEST(Cli, ExportOfAnEmptyModelWritesNothing) {

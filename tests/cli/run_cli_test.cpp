@@ -156,6 +156,16 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_EQ(rows.status, 1);
   EXPECT_TRUE(contains(last_line(rows.output), "unknown row 'best'")) << rows.output;
 
+  const CliRun thirds = iesrgs("run " + scene + " -o " + out + " --scale 3" + kTinySchedule);
+  EXPECT_EQ(thirds.status, 1);
+  EXPECT_TRUE(contains(last_line(thirds.output), "32x32, which --scale 3 does not divide"))
+      << thirds.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+
+  const CliRun dssim = iesrgs("run " + scene + " -o " + out + " --dssim nan");
+  EXPECT_NE(dssim.status, 0);
+  EXPECT_TRUE(contains(dssim.output, "must be a number in [0, 1], got nan")) << dssim.output;
+
   const CliRun threshold = iesrgs("run " + scene + " -o " + out + " --threshold -0.5");
   EXPECT_NE(threshold.status, 0);
   EXPECT_TRUE(contains(threshold.output, "--threshold: must be at least 0, got -0.5"))
