@@ -280,6 +280,10 @@ class HeaderParser {
     if (words.size() != 3) fail_line("expected 'element <name> <count>'");
     in_vertex_ = !vertex_seen_;
     if (!in_vertex_) return;  // later elements follow the vertex data and are not read
+    if (words[1] == "chunk")
+      fail_line(
+          "a compressed PLY (element 'chunk', then packed vertices, as SuperSplat and "
+          "splat-transform write it), which is not read here; convert it to the 3DGS layout first");
     if (words[1] != "vertex")
       fail_line("the first element is " + quote_token(words[1]) + ", expected 'vertex'");
     const char* end = words[2].data() + words[2].size();
@@ -333,6 +337,10 @@ std::vector<const Slot*> match_properties(const Header& header, const std::vecto
     const auto it = by_name.find(property.name);
     targets.push_back(it != by_name.end() && it->second->field ? it->second : nullptr);
   }
+  if (!seen.count("opacity") && !seen.count("scale_0") && !seen.count("f_dc_0"))
+    fail_file(name,
+              "has no Gaussian properties (f_dc_*, opacity, scale_*, rot_*): a point cloud, not a "
+              "Gaussian splatting model");
   for (const Slot& slot : slots)
     if (slot.field && !seen.count(slot.name))
       fail_file(name, "missing property " + quote_token(slot.name));
@@ -371,9 +379,12 @@ class AsciiValues {
       fail_file(name_, fmt::format("truncated: the data ends at vertex {}", vertex));
     pos_ = std::min(body_.find_first_of(" \t\r\n", start), body_.size());
     const std::string_view token = body_.substr(start, pos_ - start);
+    // from_chars takes no leading '+', which C's strtod (and so other PLY writers' readers) do.
+    const std::string_view digits =
+        token.size() > 1 && token[0] == '+' && token[1] != '-' ? token.substr(1) : token;
     double value = 0;
-    const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-    if (ec != std::errc() || ptr != token.data() + token.size())
+    const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (ec != std::errc() || ptr != digits.data() + digits.size())
       fail_file(name_, fmt::format("vertex {}: property {} has a bad number {}", vertex,
                                    quote_token(property.name), quote_token(token)));
     return value;

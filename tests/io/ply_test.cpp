@@ -179,7 +179,7 @@ TEST(Ply, BakingKeepsSaturatedOpacityFinite) {
 TEST(Ply, ReadsHandWrittenAsciiInAnyOrderAndType) {
   TempDir dir;
   // CRLF line ends, shuffled order, doubles and integers, an unknown property, no normals, a
-  // face element after the vertices.
+  // face element after the vertices, a number with a leading '+'.
   write_text(dir / "hand.ply",
              "ply\r\nformat ascii 1.0\r\ncomment written by hand\r\nelement vertex 2\r\n"
              "property double opacity\r\nproperty float rot_0\r\nproperty float rot_1\r\n"
@@ -189,7 +189,7 @@ TEST(Ply, ReadsHandWrittenAsciiInAnyOrderAndType) {
              "property int x\r\nproperty float y\r\nproperty float z\r\n"
              "element face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n"
              "-0.5 1 0 0 0 255 -3 -2 -1 0.1 0.2 0.3 7 8.5 9\r\n"
-             "2.5e1 0.7071 0.7071 0 0 0 -6 -5 -4 1 2 3 -1 -2 -3\r\n"
+             "+2.5e1 0.7071 0.7071 0 0 0 -6 -5 -4 1 2 3 -1 -2 -3\r\n"
              "3 0 1 1\r\n");
   const SplatCloud cloud = read_ply(dir / "hand.ply");
   EXPECT_EQ(cloud.sh_degree, 0);
@@ -262,6 +262,15 @@ TEST(Ply, RejectsBadInputNamingFileAndProblem) {
       {"list.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\n",
        "list properties in the vertex element are not supported"},
       {"novertex.ply", "ply\nformat ascii 1.0\nend_header\n", "the header has no vertex element"},
+      {"compressed.ply",
+       "ply\nformat binary_little_endian 1.0\nelement chunk 1\nproperty float min_x\n"
+       "element vertex 1\nproperty uint packed_position\nend_header\n",
+       "a compressed PLY (element 'chunk'"},
+      {"points3D.ply",
+       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+       "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+       "end_header\n1 2 3 255 0 0\n",
+       "has no Gaussian properties (f_dc_*, opacity, scale_*, rot_*): a point cloud"},
   };
   for (const auto& c : cases) {
     write_text(dir / c.file, c.bytes);
