@@ -4,6 +4,9 @@
 
 #include <filesystem>
 
+#include "core/error.hpp"
+#include "train/trainer.hpp"
+
 namespace iesrgs::cli {
 
 void add_synth_command(CLI::App& app);
@@ -18,9 +21,16 @@ void add_external_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 
-// A trained model given as its training folder (its point_cloud.ply) or a model file.
+// A trained model given as its training folder (its point_cloud.ply) or a model file. Throws Error
+// for a folder whose training has not finished.
 inline std::filesystem::path model_file(const std::filesystem::path& path) {
-  return std::filesystem::is_directory(path) ? path / "point_cloud.ply" : path;
+  if (!std::filesystem::is_directory(path)) return path;
+  const std::filesystem::path model = path / "point_cloud.ply";
+  if (!std::filesystem::exists(model) && std::filesystem::exists(train::checkpoint_path(path)))
+    fail_file(path,
+              "its training has not finished (a checkpoint, no point_cloud.ply yet): the same "
+              "train command with --resume continues it");
+  return model;
 }
 
 }  // namespace iesrgs::cli

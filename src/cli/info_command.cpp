@@ -135,7 +135,8 @@ void add_info_command(CLI::App& app) {
   command->callback([args, load_images] {
     const std::filesystem::path path = args->path;
     const bool training_folder =
-        !is_scene(path) && std::filesystem::exists(path / "point_cloud.ply");
+        !is_scene(path) && (std::filesystem::exists(path / "point_cloud.ply") ||
+                            std::filesystem::exists(train::checkpoint_path(path)));
     if (is_model_file(path) || training_folder) {
       print_model_summary(model_file(path));
       return;

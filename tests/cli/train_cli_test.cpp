@@ -74,6 +74,28 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   for (const char* folder : {"rgb", "depth", "alpha"})
     EXPECT_FALSE(std::filesystem::exists(dir / "orbit" / folder / "path_0002.png")) << folder;
   EXPECT_TRUE(std::filesystem::exists(dir / "orbit" / "rgb" / "path_0001.png"));
+  // A render.json naming files outside its folder removes none of them.
+  write_file_atomically(dir / "keep.png", "x");
+  write_file_atomically(dir / "orbit" / "render.json", R"({"names": ["../../keep"]})");
+  ASSERT_EQ(iesrgs("render " + out + " " + scene + " -o " + (dir / "orbit").string() +
+                   " --path orbit --frames 1")
+                .status,
+            0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "keep.png"));
+
+  // eval scores renders against the split they were made of, which render.json records.
+  const CliRun path_scored = iesrgs("eval " + (dir / "orbit").string() + " " + scene);
+  EXPECT_EQ(path_scored.status, 1);
+  EXPECT_TRUE(contains(last_line(path_scored.output), "frames of a camera path"))
+      << path_scored.output;
+  const std::string train_views = (dir / "train_views").string();
+  ASSERT_EQ(iesrgs("render " + out + " " + scene + " -o " + train_views + " --split train").status,
+            0);
+  const CliRun other_split = iesrgs("eval --lpips none " + train_views + " " + scene);
+  EXPECT_EQ(other_split.status, 1);
+  EXPECT_TRUE(contains(last_line(other_split.output), "of the train split, and --split test"))
+      << other_split.output;
+  EXPECT_EQ(iesrgs("eval --lpips none --split train " + train_views + "/rgb " + scene).status, 0);
 
   const CliRun bench = iesrgs("bench raster --model " + out + " --scene " + scene +
                               " --scale 2 --views 3 --iterations 1");
@@ -132,6 +154,16 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
       0);
   const auto report = nlohmann::json::parse(read_file(dir / "run" / "training.json"));
   const std::string model = read_file(dir / "run" / "point_cloud.ply");
+  // A folder with a checkpoint and no model yet is a training to resume, not a missing file.
+  std::filesystem::create_directories(dir / "unfinished");
+  std::filesystem::copy_file(dir / "run" / "checkpoint.pt", dir / "unfinished" / "checkpoint.pt");
+  for (const std::string command : {"info ", "export "}) {
+    const CliRun unfinished =
+        iesrgs(command + (dir / "unfinished").string() + (command == "export " ? " x.splat" : ""));
+    EXPECT_EQ(unfinished.status, 1) << command;
+    EXPECT_TRUE(contains(last_line(unfinished.output), "its training has not finished"))
+        << unfinished.output;
+  }
   const CliRun resumed = iesrgs(train + " --resume");
   ASSERT_EQ(resumed.status, 0) << resumed.output;
   EXPECT_TRUE(contains(resumed.output, "resuming")) << resumed.output;
@@ -207,8 +239,8 @@ TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {
   const CliRun none = iesrgs("train " + scene + " -o " + (dir / "c").string() + " --iterations 0");
   EXPECT_NE(none.status, 0);
   EXPECT_TRUE(contains(none.output, "--iterations: must be greater than 0, got 0")) << none.output;
-  const CliRun bright = iesrgs("train " + scene + " -o " + (dir / "c").string() +
-                               " --background 2,0,0.5");
+  const CliRun bright =
+      iesrgs("train " + scene + " -o " + (dir / "c").string() + " --background 2,0,0.5");
   EXPECT_EQ(bright.status, 1);
   EXPECT_TRUE(contains(last_line(bright.output), "each of r,g,b must be in [0, 1], got '2,0,0.5'"))
       << bright.output;
