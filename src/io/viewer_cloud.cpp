@@ -1,6 +1,7 @@
 #include "io/viewer_cloud.hpp"
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,22 +18,62 @@ bool all_finite(const std::vector<float>& values, size_t from, size_t count, boo
                      [&](float v) { return std::isfinite(exponentiated ? std::exp(v) : v); });
 }
 
+// Why Gaussian i of `cloud` cannot be drawn, or nullptr when it can.
+const char* undrawable(const SplatCloud& cloud, size_t i) {
+  const size_t rest = cloud.sh_rest.size() / cloud.size();
+  if (!all_finite(cloud.positions, 3 * i, 3, false)) return "a non-finite position";
+  if (!all_finite(cloud.log_scales, 3 * i, 3, true))
+    return "a scale that is no finite float once exponentiated";
+  if (!all_finite(cloud.sh_dc, 3 * i, 3, false) ||
+      !all_finite(cloud.sh_rest, rest * i, rest, false))
+    return "a non-finite colour";
+  if (!std::isfinite(cloud.opacity[i])) return "a non-finite opacity";
+  const double norm = quaternion_norm(&cloud.rotations[4 * i]);
+  if (!std::isfinite(norm) || norm == 0) return "a zero or non-finite rotation";
+  return nullptr;
+}
+
+// The Gaussians `keep` of `cloud`, in that order.
+SplatCloud select(const SplatCloud& cloud, const std::vector<size_t>& keep) {
+  SplatCloud out = cloud;
+  const size_t n = cloud.size();
+  for (auto [from, to] : {std::pair{&cloud.positions, &out.positions},
+                          {&cloud.sh_dc, &out.sh_dc},
+                          {&cloud.sh_rest, &out.sh_rest},
+                          {&cloud.opacity, &out.opacity},
+                          {&cloud.log_scales, &out.log_scales},
+                          {&cloud.rotations, &out.rotations},
+                          {&cloud.filter_3d, &out.filter_3d}}) {
+    const size_t stride = from->size() / n;
+    to->clear();
+    for (size_t i : keep)
+      to->insert(to->end(), from->begin() + i * stride, from->begin() + (i + 1) * stride);
+  }
+  return out;
+}
+
 }  // namespace
 
 SplatCloud viewer_cloud(const SplatCloud& cloud, const std::filesystem::path& path) {
   check_splat_cloud(cloud, path);  // before baking indexes the arrays
-  SplatCloud baked = bake_filter_3d(cloud);
-  const size_t rest = baked.size() ? baked.sh_rest.size() / baked.size() : 0;
+  const SplatCloud baked = bake_filter_3d(cloud);
+  std::vector<size_t> keep;
+  std::string first_left_out;
   for (size_t i = 0; i < baked.size(); ++i) {
-    const double norm = quaternion_norm(&baked.rotations[4 * i]);
-    if (!all_finite(baked.positions, 3 * i, 3, false) ||
-        !all_finite(baked.log_scales, 3 * i, 3, true) ||
-        !all_finite(baked.sh_dc, 3 * i, 3, false) ||
-        !all_finite(baked.sh_rest, rest * i, rest, false) || !std::isfinite(baked.opacity[i]) ||
-        !std::isfinite(norm) || norm == 0)
-      fail_file(path, fmt::format("Gaussian {} has a non-finite or degenerate parameter", i));
+    if (const char* reason = undrawable(baked, i)) {
+      if (first_left_out.empty()) first_left_out = fmt::format("Gaussian {} has {}", i, reason);
+    } else {
+      keep.push_back(i);
+    }
   }
-  return baked;
+  if (keep.size() == baked.size()) return baked;
+  if (keep.empty())
+    fail_file(path, fmt::format("no Gaussian can be drawn ({}, and so have all the others)",
+                                first_left_out));
+  // As gsplat's export does; renders cull such Gaussians too.
+  spdlog::warn("{}: left out {} of {} Gaussians that no viewer can draw ({})", path.string(),
+               baked.size() - keep.size(), baked.size(), first_left_out);
+  return select(baked, keep);
 }
 
 double quaternion_norm(const float* q) {

@@ -8,9 +8,10 @@
 
 namespace iesrgs {
 
-// The cloud with its 3D filter baked in (bake_filter_3d). Throws Error naming `path` when the
-// arrays disagree in size, or when a Gaussian has a non-finite parameter, a scale that overflows
-// once exponentiated or a zero rotation.
+// The cloud with its 3D filter baked in (bake_filter_3d), less the Gaussians no viewer can draw:
+// a non-finite parameter, a scale that overflows once exponentiated, a zero rotation (a warning
+// names `path` and says how many). Throws Error naming `path` when the arrays disagree in size or
+// no Gaussian is left.
 SplatCloud viewer_cloud(const SplatCloud& cloud, const std::filesystem::path& path);
 
 // Length of the quaternion at q[0..3].
