@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "core/error.hpp"
@@ -13,6 +14,8 @@
 namespace iesrgs {
 
 namespace fs = std::filesystem;
+
+constexpr double kWidestFieldOfView = 179;  // degrees
 
 std::vector<const Camera*> Scene::split(Split which) const {
   std::vector<const Camera*> out;
@@ -81,6 +84,21 @@ void require_unique_names(const Scene& scene) {
                                         it->second->image_path.string(), camera.image_path.string(),
                                         split_name(camera.split), camera.name));
   }
+}
+
+// A pinhole camera sees less than 180 degrees: a focal length that makes it nearly that wide is a
+// unit mistake, and would project Gaussians to the edge of infinity.
+void require_pinhole_view(const Camera& camera) {
+  const Intrinsics& k = camera.stored;
+  const double widest = kWidestFieldOfView * kPi / 180;
+  const bool finite =
+      std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) && std::isfinite(k.cy);
+  if (finite && k.fov_x() < widest && k.fov_y() < widest) return;
+  fail_file(camera.image_path,
+            fmt::format("focal lengths {:.6g}, {:.6g} px and principal point {:.6g}, {:.6g} for "
+                        "a {}x{} image: a pinhole camera needs finite values and a field of view "
+                        "under {} degrees",
+                        k.fx, k.fy, k.cx, k.cy, k.width, k.height, kWidestFieldOfView));
 }
 
 }  // namespace
@@ -152,6 +170,7 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   scene.background = options.background;
   scene.downscale = options.downscale;
   for (Camera& camera : scene.cameras) {
+    require_pinhole_view(camera);
     camera.intrinsics = camera.stored.scaled(1.0 / options.downscale);
     if (camera.intrinsics.width < 1 || camera.intrinsics.height < 1)
       fail_file(camera.image_path,

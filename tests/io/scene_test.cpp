@@ -111,6 +111,18 @@ TEST(Scene, CamerasAroundAnObjectAreNotWarnedAbout) {
   EXPECT_FALSE(camera_spread_warning(load_scene(dir / "scene")).has_value());
 }
 
+TEST(Scene, AFieldOfViewOf180DegreesIsRefused) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 1});
+  const auto json_path = dir / "scene" / "transforms_train.json";
+  nlohmann::json transforms = nlohmann::json::parse(read_file(json_path));
+  transforms["camera_angle_x"] = 3.1415;  // radians: a focal length of 0.0004 pixels
+  write_file_atomically(json_path, transforms.dump());
+  const std::string message = error_message([&] { load_scene(dir / "scene"); });
+  EXPECT_TRUE(contains(message, "a field of view under 179 degrees")) << message;
+  EXPECT_TRUE(contains(message, "r_0.png")) << message;
+}
+
 TEST(Scene, ADownscaleThatLeavesNoPixelIsRefused) {
   TempDir dir;
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 1});
