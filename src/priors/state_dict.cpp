@@ -121,7 +121,10 @@ const Object& unwrap_containers(const pickle::Unpickler& unpickler, size_t root)
   const Object* dict = &unpickler.object(root);
   for (int depth = 0; depth < kMaxWrapperDepth; ++depth) {
     if (dict->kind != Kind::Dict)
-      throw FormatError(fmt::format("holds a {}, not a dict of tensors", kind_name(dict->kind)));
+      throw FormatError(fmt::format(
+          "holds a pickled {} where a network's weights are a dict of tensors (an iesrgs "
+          "training checkpoint, say, is no network checkpoint)",
+          kind_name(dict->kind)));
     const Object* inner = nullptr;
     for (const char* key : kWrapperKeys) {
       const auto found = unpickler.find(*dict, key);

@@ -298,7 +298,7 @@ TEST(NerfstudioScene, BadInputGivesOneLineErrorNamingFileAndProblem) {
        raw(valid.substr(0, valid.size() - 1)),
        {"malformed JSON at byte " + std::to_string(valid.size()), "unexpected end of input"}},
       {"malformed", raw("{\"fl_x\": 10,, }"), {"malformed JSON at byte 13"}},
-      {"number overflow", raw("{\"fl_x\": 1e999}"), {"invalid JSON", "1e999"}},
+      {"number overflow", raw("{\"fl_x\": 1e999}"), {"invalid JSON (number overflow", "1e999"}},
       {"not an object", raw("[1, 2]"), {"top level is not a JSON object"}},
       {"no frames key", edited([](json& d) { d.erase("frames"); }), {"missing \"frames\""}},
       {"frames not array", edited([](json& d) { d["frames"] = 3; }), {"\"frames\" must be"}},
