@@ -208,16 +208,19 @@ class Pipeline {
 
 namespace {
 
-// The HR truth must be the LR views' size times the scale, as the HR rows are trained at and the
-// truth-masked rows compare with.
+// The mask-oracle row compares the references with the HR truth pixel by pixel, at the LR views'
+// size times the scale: the truth must have that size. (Other rows render the test views at the
+// truth's own size, whatever the scale.)
 void require_scale_divides(const Scene& hr, const Scene& lr, int scale) {
   for (size_t i = 0; i < hr.cameras.size(); ++i) {
+    if (hr.cameras[i].split != Split::Train) continue;
     const Intrinsics &high = hr.cameras[i].intrinsics, &low = lr.cameras[i].intrinsics;
     if (high.width == low.width * scale && high.height == low.height * scale) continue;
     fail_file(hr.cameras[i].image_path,
               fmt::format("at --downscale {} this view is {}x{}, which --scale {} does not divide "
-                          "(the LR view would be {}x{}, upscaled {}x{}); pick a scale or "
-                          "downscale that divides the image size",
+                          "(the LR view would be {}x{}, upscaled {}x{}), which the mask-oracle "
+                          "row compares with it pixel by pixel; pick a scale or downscale that "
+                          "divides the image size",
                           hr.downscale, high.width, high.height, scale, low.width, low.height,
                           low.width * scale, low.height * scale));
   }
@@ -237,7 +240,8 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
     lr_options.downscale *= o_.scale;
   }
   lr_scene_ = load_scene(o_.scene, lr_options);
-  if (hr_scene_) require_scale_divides(*hr_scene_, lr_scene_, o_.scale);
+  if (hr_scene_ && any_row([](const RowSpec& row) { return row.oracle_mask; }))
+    require_scale_divides(*hr_scene_, lr_scene_, o_.scale);
   require_trainable_views(lr_scene_);
   lr_images_ = std::make_unique<ViewImages>(lr_scene_);
   threshold_ = o_.threshold >= 0     ? o_.threshold
@@ -285,7 +289,8 @@ void Pipeline::check_cached_inputs() const {
   if (any_row(Source::SuperResolved))
     require(external_stage_current(lr_scene_, *lr_images_, o_.external, o_.output / "external"),
             o_.output / "external", "external",
-            fmt::format("iesrgs external -o {} or iesrgs run", (o_.output / "external").string()));
+            fmt::format("iesrgs external --downscale {} -o {} or iesrgs run", lr_scene_.downscale,
+                        (o_.output / "external").string()));
   if (rows_use_internal_references())
     require(internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
                                    o_.output / "internal"),
