@@ -51,6 +51,7 @@ std::vector<std::filesystem::path> render_files(std::filesystem::path dir) {
 // r_0).
 void check_rendered_split(const EvalArgs& args) {
   std::filesystem::path folder = args.renders;
+  if (!folder.has_filename()) folder = folder.parent_path();  // given as "out/rgb/"
   if (folder.filename() == "rgb" && !std::filesystem::exists(folder / "render.json"))
     folder = folder.parent_path();
   const std::filesystem::path record = folder / "render.json";

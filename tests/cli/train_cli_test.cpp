@@ -95,6 +95,7 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   EXPECT_EQ(other_split.status, 1);
   EXPECT_TRUE(contains(last_line(other_split.output), "of the train split, and --split test"))
       << other_split.output;
+  EXPECT_EQ(iesrgs("eval --lpips none " + train_views + "/rgb/ " + scene).status, 1);
   EXPECT_EQ(iesrgs("eval --lpips none --split train " + train_views + "/rgb " + scene).status, 0);
 
   const CliRun bench = iesrgs("bench raster --model " + out + " --scene " + scene +
