@@ -47,8 +47,8 @@ struct TrainConfig {
   int64_t checkpoint_every = 1000;
   int64_t test_every = 1000;  // iterations between test PSNR reports; 0 = never
   int test_views = 10;        // test views in those reports (evenly spaced); 0 = all
-  int64_t log_every = 10;     // iterations between train_log.csv rows (test reports and the
-                              // last iteration always get one)
+  int64_t log_every = 10;     // iterations between train_log.csv rows (test reports, the last
+                              // iteration and an interruption always get one)
 };
 
 // A built-in preset: "paper" (the 30k-iteration schedule of 3DGS and Mip-Splatting, for GPUs), or

@@ -194,8 +194,8 @@ void Trainer::load_checkpoint() {
   };
   seconds_before_ = stored("seconds");
   last_loss_ = stored("loss");
-  if (const double psnr = stored("test_psnr"); extras["test_psnr"].defined() && !std::isnan(psnr))
-    last_test_psnr_ = psnr;
+  // Older checkpoints stored 0 for no report (a real one of 0 dB would need an error of 1).
+  if (const double psnr = stored("test_psnr"); psnr > 0) last_test_psnr_ = psnr;
   std::istringstream view_rng(tensor_bytes(extras["view_rng"]));
   view_rng >> view_rng_;
   if (!view_rng) fail_file(path, "the stored view sampler state is corrupt");
