@@ -46,7 +46,9 @@ Vec3 up_direction(const std::vector<const Camera*>& cameras) {
   mean_up = normalized(mean_up);
   const auto [values, vectors] = torch::linalg_eigh(moments, "L");  // ascending
   const auto v = vectors.accessor<double, 2>();
-  if (values[0].item<double>() < kClearlyLeastSpread * values[1].item<double>()) {
+  const double least = values[0].item<double>(), second = values[1].item<double>();
+  // Right axes parallel to rounding leave both at eigensolver noise.
+  if (second > 1e-9 * double(cameras.size()) && least < kClearlyLeastSpread * second) {
     const Vec3 up{v[0][0], v[1][0], v[2][0]};
     return up.dot(mean_up) < 0 ? -up : up;
   }

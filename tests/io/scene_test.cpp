@@ -116,7 +116,7 @@ TEST(Scene, AFieldOfViewOf180DegreesIsRefused) {
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 1});
   const auto json_path = dir / "scene" / "transforms_train.json";
   nlohmann::json transforms = nlohmann::json::parse(read_file(json_path));
-  transforms["camera_angle_x"] = 3.1415;  // radians: a focal length of 0.0004 pixels
+  transforms["camera_angle_x"] = 3.1415;  // radians: a focal length of 0.0002 pixels
   write_file_atomically(json_path, transforms.dump());
   const std::string message = error_message([&] { load_scene(dir / "scene"); });
   EXPECT_TRUE(contains(message, "a field of view under 179 degrees")) << message;
