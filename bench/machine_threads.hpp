@@ -6,9 +6,14 @@
 
 namespace iesrgs {
 
-// Registers the argument "threads": OMP_NUM_THREADS, or every core.
-inline void machine_threads(benchmark::internal::Benchmark* b) {
-  b->ArgName("threads")->Arg(omp_get_max_threads());
+// The argument "threads" (OMP_NUM_THREADS, or every core), timed in wall-clock milliseconds with
+// the process's CPU time over all threads.
+inline void on_machine_threads(benchmark::internal::Benchmark* b) {
+  b->ArgName("threads")
+      ->Arg(omp_get_max_threads())
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime()
+      ->MeasureProcessCPUTime();
 }
 
 }  // namespace iesrgs

@@ -38,21 +38,9 @@ void BM_ResizeRgba200To800(benchmark::State& state) {
   resize_case(state, 200, 200, 4, 800, 800);
 }
 
-BENCHMARK(BM_ResizeRgba800To200)
-    ->Apply(machine_threads)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
-BENCHMARK(BM_ResizeRgb1080x1920To540x960)
-    ->Apply(machine_threads)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
-BENCHMARK(BM_ResizeRgba200To800)
-    ->Apply(machine_threads)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+BENCHMARK(BM_ResizeRgba800To200)->Apply(on_machine_threads);
+BENCHMARK(BM_ResizeRgb1080x1920To540x960)->Apply(on_machine_threads);
+BENCHMARK(BM_ResizeRgba200To800)->Apply(on_machine_threads);
 
 }  // namespace
 }  // namespace iesrgs

@@ -55,31 +55,11 @@ void BM_SrPan200To800Tiled128(benchmark::State& state) {
   upscale_case(state, "pan", 128);
 }
 
-BENCHMARK(BM_SrBicubic200To800)
-    ->Apply(machine_threads)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
-BENCHMARK(BM_SrSafmn200To800)
-    ->Apply(machine_threads)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
-BENCHMARK(BM_SrImdn200To800)
-    ->Apply(machine_threads)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
-BENCHMARK(BM_SrPan200To800)
-    ->Apply(machine_threads)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
-BENCHMARK(BM_SrPan200To800Tiled128)
-    ->Apply(machine_threads)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+BENCHMARK(BM_SrBicubic200To800)->Apply(on_machine_threads);
+BENCHMARK(BM_SrSafmn200To800)->Apply(on_machine_threads);
+BENCHMARK(BM_SrImdn200To800)->Apply(on_machine_threads);
+BENCHMARK(BM_SrPan200To800)->Apply(on_machine_threads);
+BENCHMARK(BM_SrPan200To800Tiled128)->Apply(on_machine_threads);
 
 }  // namespace
 }  // namespace iesrgs

@@ -9,25 +9,6 @@ namespace {
 
 using sr_testing::kReleasedWeights;
 using sr_testing::lego_crop;
-using sr_testing::parameter_count;
-using sr_testing::released_fixture_error;
-using sr_testing::tiny_fixture_error;
-
-TEST(Safmn, TinySeededConfigurationMatchesTheOfficialModule) {
-  Safmn net(SafmnOptions{8, 2, 2.0, 2});
-  EXPECT_LT(tiny_fixture_error(net, "safmn"), 1e-5);
-}
-
-TEST(Safmn, DefaultConfigurationHasTheReleasedParameterCount) {
-  Safmn net;
-  EXPECT_EQ(parameter_count(*net), 237000);
-}
-
-TEST(Safmn, ReleasedCheckpointMatchesTheOfficialModule) {
-  const auto file = kReleasedWeights / "SAFMN_x4.pth";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " not found (shared data absent)";
-  EXPECT_LT(released_fixture_error("safmn", file), 1e-4);
-}
 
 TEST(Safmn, InputsBelowThePoolingPyramidArePaddedAndCropped) {
   const auto file = kReleasedWeights / "SAFMN_x4.pth";
