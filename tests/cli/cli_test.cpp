@@ -107,6 +107,9 @@ TEST(Cli, BenchRefusesEmptyWork) {
   const CliRun threads = iesrgs("bench raster --threads -1");
   EXPECT_EQ(threads.status, 105);
   EXPECT_TRUE(contains(threads.output, "--threads: must be at least 0, got -1")) << threads.output;
+  const CliRun crowd = iesrgs("bench ssim --threads 100000");
+  EXPECT_EQ(crowd.status, 105);
+  EXPECT_TRUE(contains(crowd.output, "100000 not in range 0 to 1024")) << crowd.output;
   const CliRun alone = iesrgs("bench raster --model nowhere.ply");
   EXPECT_EQ(alone.status, 107);
   EXPECT_TRUE(contains(alone.output, "--model requires --scene")) << alone.output;
