@@ -60,7 +60,9 @@ void check_rendered_split(const EvalArgs& args) {
   if (!report.is_object()) return;
   if (report.contains("path"))
     fail_file(record, "these renders are frames of a camera path, which have no ground truth");
-  const std::string split = report.value("split", args.split);
+  const auto recorded = report.find("split");
+  if (recorded == report.end() || !recorded->is_string()) return;  // an older or edited record
+  const std::string split = recorded->get<std::string>();
   if (split != args.split)
     fail_file(record, fmt::format("these renders are of the {} split, and --split {} would score "
                                   "them against other views of the same names; use --split {}",
