@@ -12,6 +12,7 @@
 #include "loss/photometric.hpp"
 #include "loss/ssim.hpp"
 #include "loss/texture_fusion.hpp"
+#include "timing.hpp"
 
 namespace iesrgs::loss {
 namespace {
@@ -59,16 +60,8 @@ void ssim_sizes(benchmark::internal::Benchmark* b) {
     for (int threads : {1, 2}) b->Args({side, threads});
 }
 
-BENCHMARK(BM_SsimForward)
-    ->Apply(ssim_sizes)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
-BENCHMARK(BM_SsimForwardBackward)
-    ->Apply(ssim_sizes)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+BENCHMARK(BM_SsimForward)->Apply(ssim_sizes)->Apply(timed_in_wall_milliseconds);
+BENCHMARK(BM_SsimForwardBackward)->Apply(ssim_sizes)->Apply(timed_in_wall_milliseconds);
 
 // A mask like IE-SRGS's M on lego at x4: thin broken outlines (every 4th pixel of a dozen circles
 // in the middle of the view), about 0.5 % of the pixels.
@@ -108,9 +101,7 @@ void BM_GuidedTexture(benchmark::State& state) {
 BENCHMARK(BM_GuidedTexture)
     ->ArgNames({"side", "threads", "masked"})
     ->ArgsProduct({{400, 800}, {1, 2}, {0, 1}})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+    ->Apply(timed_in_wall_milliseconds);
 
 // The internal depth term of a fusion step with its gradients, as the hand-written kernel
 // (`ops:0`) or as the tensor ops that GPUs run (`ops:1`), at 400x400: a render covering about
@@ -133,13 +124,7 @@ void BM_InternalDepthTerm(benchmark::State& state) {
   }
 }
 
-BENCHMARK(BM_InternalDepthTerm)
-    ->ArgName("ops")
-    ->Arg(0)
-    ->Arg(1)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+BENCHMARK(BM_InternalDepthTerm)->ArgName("ops")->Arg(0)->Arg(1)->Apply(timed_in_wall_milliseconds);
 
 }  // namespace
 }  // namespace iesrgs::loss

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gs/neighbors.hpp"
+#include "timing.hpp"
 
 namespace iesrgs::gs {
 namespace {
@@ -29,9 +30,7 @@ void BM_StartingScales(benchmark::State& state) {
 BENCHMARK(BM_StartingScales)
     ->ArgNames({"points", "outlier", "threads"})
     ->ArgsProduct({{100000}, {0, 100}, {2}})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+    ->Apply(timed_in_wall_milliseconds);
 
 }  // namespace
 }  // namespace iesrgs::gs

@@ -6,6 +6,7 @@
 #include "gs/benchmark_model.hpp"
 #include "gs/densify.hpp"
 #include "gs/optimizer.hpp"
+#include "timing.hpp"
 
 namespace iesrgs::gs {
 namespace {
@@ -40,15 +41,11 @@ void BM_DensifyStatistics(benchmark::State& state) {
 BENCHMARK(BM_AdamStep)
     ->ArgNames({"gaussians", "threads"})
     ->ArgsProduct({{100000, 500000}, {1, 2}})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+    ->Apply(timed_in_wall_milliseconds);
 BENCHMARK(BM_DensifyStatistics)
     ->ArgNames({"gaussians", "views", "threads"})
     ->ArgsProduct({{100000}, {1, 3}, {1, 2}})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+    ->Apply(timed_in_wall_milliseconds);
 
 }  // namespace
 }  // namespace iesrgs::gs

@@ -7,6 +7,7 @@
 #include "gs/sh.hpp"
 #include "raster/rasterizer.hpp"
 #include "raster/synthetic_scene.hpp"
+#include "timing.hpp"
 
 namespace iesrgs::raster {
 namespace {
@@ -68,15 +69,11 @@ void BM_RasterForwardBackward(benchmark::State& state) {
 BENCHMARK(BM_RasterForward)
     ->Args({100000, 800, 1})
     ->Args({100000, 800, 2})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+    ->Apply(timed_in_wall_milliseconds);
 BENCHMARK(BM_RasterForwardBackward)
     ->Args({100000, 800, 1})
     ->Args({100000, 800, 2})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+    ->Apply(timed_in_wall_milliseconds);
 
 }  // namespace
 }  // namespace iesrgs::raster

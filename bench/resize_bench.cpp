@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "io/resize.hpp"
-#include "machine_threads.hpp"
+#include "timing.hpp"
 
 namespace iesrgs {
 namespace {

@@ -5,10 +5,10 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "machine_threads.hpp"
 #include "priors/sr/registry.hpp"
 #include "priors/sr/sr_net.hpp"
 #include "priors/sr/tiling.hpp"
+#include "timing.hpp"
 
 namespace iesrgs {
 namespace {
