@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
+#include <string>
 
 #include "core/error.hpp"
 #include "train/trainer.hpp"
@@ -27,11 +28,11 @@ inline std::filesystem::path model_file(const std::filesystem::path& path) {
   if (!std::filesystem::is_directory(path)) return path;
   const std::filesystem::path model = path / "point_cloud.ply";
   if (!std::filesystem::exists(model) && std::filesystem::exists(train::checkpoint_path(path)))
-    fail_file(path, std::filesystem::exists(path / "stage.json")
-                        ? "its training has not finished (a checkpoint, no point_cloud.ply yet): "
-                          "the iesrgs run, internal or fuse command that made it continues it"
-                        : "its training has not finished (a checkpoint, no point_cloud.ply yet): "
-                          "the same train command with --resume continues it");
+    fail_file(path, std::string("its training has not finished (a checkpoint, no "
+                                "point_cloud.ply yet): ") +
+                        (std::filesystem::exists(path / "stage.json")
+                             ? "the iesrgs run, internal or fuse command that made it continues it"
+                             : "the same train command with --resume continues it"));
   return model;
 }
 

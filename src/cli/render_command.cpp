@@ -57,10 +57,10 @@ void remove_earlier_views(const std::filesystem::path& dir, const std::vector<st
   const nlohmann::json earlier = nlohmann::json::parse(read_file(report), nullptr, false);
   if (!earlier.is_object() || !earlier.contains("names") || !earlier["names"].is_array()) return;
   for (const nlohmann::json& name : earlier["names"]) {
-    if (!name.is_string() || !inside_folder(name.get<std::string>()) ||
-        std::find(names.begin(), names.end(), name.get<std::string>()) != names.end())
-      continue;
+    if (!name.is_string()) continue;
     const std::string view = name.get<std::string>();
+    if (!inside_folder(view) || std::find(names.begin(), names.end(), view) != names.end())
+      continue;
     for (const std::filesystem::path& file :
          {dir / "rgb" / (view + ".png"), dir / "depth" / (view + ".npy"),
           dir / "depth" / (view + ".png"), dir / "alpha" / (view + ".png")}) {

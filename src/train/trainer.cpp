@@ -31,9 +31,6 @@ namespace iesrgs::train {
 
 namespace {
 
-// A checkpoint's test PSNR when no test report was made.
-constexpr double kNoReport = std::numeric_limits<double>::quiet_NaN();
-
 std::atomic<bool> interrupt_requested{false};
 
 extern "C" void request_interrupt(int signal) {
@@ -148,7 +145,7 @@ void Trainer::save_checkpoint() {
        {"torch_rng", torch_rng},
        {"seconds", torch::tensor(training_seconds(), torch::kFloat64)},
        {"loss", torch::tensor(last_loss_, torch::kFloat64)},
-       {"test_psnr", torch::tensor(last_test_psnr_.value_or(kNoReport), torch::kFloat64)},
+       {"test_psnr", torch::tensor(last_test_psnr_.value_or(0), torch::kFloat64)},
        {"background", background_tensor()}});
   checkpoint_iteration_ = iteration_;
 }
@@ -194,7 +191,7 @@ void Trainer::load_checkpoint() {
   };
   seconds_before_ = stored("seconds");
   last_loss_ = stored("loss");
-  // Older checkpoints stored 0 for no report (a real one of 0 dB would need an error of 1).
+  // 0 stands for no report: a real one of 0 dB would need an error of 1 on every pixel.
   if (const double psnr = stored("test_psnr"); psnr > 0) last_test_psnr_ = psnr;
   std::istringstream view_rng(tensor_bytes(extras["view_rng"]));
   view_rng >> view_rng_;
