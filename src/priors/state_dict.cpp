@@ -220,6 +220,15 @@ StateDict parse_state_dict(std::string_view bytes, const fs::path& source) {
   }
 }
 
+const torch::Tensor* find_weight(const StateDict& weights, const std::string& name, int64_t dims,
+                                 const fs::path& file) {
+  const auto it = weights.find(name);
+  if (it == weights.end()) return nullptr;
+  if (it->second.dim() != dims)
+    fail_file(file, fmt::format("{} has {} dimensions, not {}", name, it->second.dim(), dims));
+  return &it->second;
+}
+
 void load_state_dict(torch::nn::Module& module, const StateDict& weights, const fs::path& file) {
   std::map<std::string, torch::Tensor> targets;
   for (const auto& item : module.named_parameters()) targets.emplace(item.key(), item.value());

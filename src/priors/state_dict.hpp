@@ -26,6 +26,11 @@ StateDict read_state_dict(const std::filesystem::path& file);
 // The same for a checkpoint already in memory; `source` names it in error messages.
 StateDict parse_state_dict(std::string_view bytes, const std::filesystem::path& source);
 
+// The entry `name`, or null when absent. A present entry must have `dims` dimensions (its shape
+// is about to be read), else the error names `file` and the entry.
+const torch::Tensor* find_weight(const StateDict& weights, const std::string& name, int64_t dims,
+                                 const std::filesystem::path& file);
+
 // Copies `weights` into the parameters and buffers of `module`, strictly:
 // every name must exist on both sides with the same shape. The error names
 // `file` and the first missing, unexpected or mis-shaped entry.

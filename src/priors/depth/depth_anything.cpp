@@ -35,10 +35,9 @@ DepthAnythingConfig depth_anything_config(const std::string& encoder) {
 }
 
 std::string depth_anything_encoder(const StateDict& weights, const std::filesystem::path& file) {
-  const auto cls = weights.find("pretrained.cls_token");
-  if (cls == weights.end() || cls->second.dim() != 3)
-    fail_file(file, "not a Depth Anything V2 checkpoint (no pretrained.cls_token of 3 dimensions)");
-  const int64_t width = cls->second.size(2);
+  const torch::Tensor* cls = find_weight(weights, "pretrained.cls_token", 3, file);
+  if (!cls) fail_file(file, "not a Depth Anything V2 checkpoint (no pretrained.cls_token)");
+  const int64_t width = cls->size(2);
   for (const char* encoder : {"vits", "vitb", "vitl"})
     if (depth_anything_config(encoder).vit.embed_dim == width) return encoder;
   fail_file(file, fmt::format("embedding width {} matches no released Depth Anything V2 encoder "

@@ -74,36 +74,52 @@ class NetworkSr final : public SrNet {
   int64_t min_side_;
 };
 
-template <class Net>
-std::unique_ptr<SrNet> with_weights(const std::string& model, Net net, int scale,
-                                    const fs::path& weights, int64_t min_side = 1) {
-  const fs::path file = weights.empty() ? default_sr_weights(model, scale) : weights;
-  if (weights.empty() && !fs::exists(file))
+// `weights`, or when empty the model's default checkpoint, which must then exist.
+fs::path checkpoint_file(const std::string& model, int scale, const fs::path& weights) {
+  if (!weights.empty()) return weights;
+  const fs::path file = default_sr_weights(model, scale);
+  if (!fs::exists(file))
     fail(
         "{}: no weights given and the default {} does not exist (pass a checkpoint or set "
         "IESRGS_WEIGHTS_DIR)",
         model, file.string());
-  load_state_dict(*net, read_state_dict(file), file);
-  return std::make_unique<NetworkSr<Net>>(model, std::move(net), scale, min_side);
+  return file;
 }
 
 using Factory = std::function<std::unique_ptr<SrNet>(const fs::path& weights, int scale)>;
 
 // A network whose configuration is the released one at any scale.
 template <class Net, class Options>
-Factory network(const std::string& model, int64_t min_side = 1) {
-  return [model, min_side](const fs::path& weights, int scale) {
+Factory network(const std::string& model) {
+  return [model](const fs::path& weights, int scale) {
     Options options;
     options.scale = scale;
-    return with_weights(model, Net(options), scale, weights, min_side);
+    Net net(options);
+    const fs::path file = checkpoint_file(model, scale, weights);
+    load_state_dict(*net, read_state_dict(file), file);
+    return std::make_unique<NetworkSr<Net>>(model, std::move(net), scale, 1);
   };
+}
+
+// SAFMN in whichever released layout and size the checkpoint has.
+std::unique_ptr<SrNet> make_safmn(const fs::path& weights, int scale) {
+  const fs::path file = checkpoint_file("safmn", scale, weights);
+  const StateDict state = read_state_dict(file);
+  const SafmnOptions options = infer_safmn_options(state, file);
+  if (options.scale != scale)
+    fail_file(file,
+              fmt::format("a x{} SAFMN checkpoint, but x{} was requested", options.scale, scale));
+  Safmn net(options);
+  load_state_dict(*net, state, file);
+  return std::make_unique<NetworkSr<Safmn>>("safmn", std::move(net), scale,
+                                            safmn_min_side(options.release));
 }
 
 const std::map<std::string, Factory>& factories() {
   static const std::map<std::string, Factory> table = [] {
     std::map<std::string, Factory> models = {
         {"bicubic", [](const fs::path&, int scale) { return make_bicubic(scale); }},
-        {"safmn", network<Safmn, SafmnOptions>("safmn", kSafmnMinSide)},
+        {"safmn", make_safmn},
         {"imdn", network<Imdn, ImdnOptions>("imdn")},
         {"pan", network<Pan, PanOptions>("pan")},
         {"swinir", [](const fs::path& weights, int scale) { return make_swinir(weights, scale); }},

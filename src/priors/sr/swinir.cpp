@@ -224,16 +224,6 @@ bool has(const StateDict& weights, const std::string& name) {
   return weights.count(name) != 0;
 }
 
-// The entry `name`, or null when absent; its shape is read, so it must have `dims` dimensions.
-const torch::Tensor* find(const StateDict& weights, const std::string& name, int64_t dims,
-                          const std::filesystem::path& file) {
-  const auto it = weights.find(name);
-  if (it == weights.end()) return nullptr;
-  if (it->second.dim() != dims)
-    fail_file(file, fmt::format("{} has {} dimensions, not {}", name, it->second.dim(), dims));
-  return &it->second;
-}
-
 std::string block_prefix(size_t layer, int64_t block) {
   return fmt::format("layers.{}.residual_group.blocks.{}.", layer, block);
 }
@@ -253,7 +243,7 @@ void infer_residual_groups(const StateDict& weights, const std::filesystem::path
     int64_t depth = 1;
     while (has(weights, block_prefix(layer, depth) + "norm1.weight")) ++depth;
     const std::string table_name = block_prefix(layer, 0) + "attn.relative_position_bias_table";
-    const torch::Tensor* table = find(weights, table_name, 2, file);
+    const torch::Tensor* table = find_weight(weights, table_name, 2, file);
     if (!table) fail_file(file, "missing " + table_name);
     config.depths.push_back(depth);
     config.num_heads.push_back(table->size(1));
@@ -263,7 +253,7 @@ void infer_residual_groups(const StateDict& weights, const std::filesystem::path
   if (config.depths.empty())
     fail_file(file, "not a SwinIR checkpoint: no layers.0.residual_group.blocks.0 entries");
   const std::string fc1_name = block_prefix(0, 0) + "mlp.fc1.weight";
-  const torch::Tensor* fc1 = find(weights, fc1_name, 2, file);
+  const torch::Tensor* fc1 = find_weight(weights, fc1_name, 2, file);
   if (!fc1) fail_file(file, "missing " + fc1_name);
   config.mlp_hidden_dim = fc1->size(0);
 }
@@ -273,7 +263,8 @@ int stacked_upsample_scale(const StateDict& weights, const std::filesystem::path
                            int64_t num_feat) {
   int scale = 1;
   for (int stage = 0;; stage += 2) {
-    const torch::Tensor* conv = find(weights, fmt::format("upsample.{}.weight", stage), 4, file);
+    const torch::Tensor* conv =
+        find_weight(weights, fmt::format("upsample.{}.weight", stage), 4, file);
     if (!conv) return scale;
     const int64_t out = conv->size(0);
     if (out != 4 * num_feat && out != 9 * num_feat)
@@ -292,11 +283,12 @@ void infer_reconstruction(const StateDict& weights, const std::filesystem::path&
               "(resi_connection '3conv')");
   if (has(weights, "conv_up1.weight"))
     fail_file(file, "unsupported SwinIR upsampler 'nearest+conv' (real-world SR)");
-  if (const torch::Tensor* before = find(weights, "conv_before_upsample.0.weight", 4, file)) {
+  if (const torch::Tensor* before =
+          find_weight(weights, "conv_before_upsample.0.weight", 4, file)) {
     config.upsampler = SwinIRUpsampler::PixelShuffle;
     config.num_feat = before->size(0);
     config.scale = stacked_upsample_scale(weights, file, config.num_feat);
-  } else if (const torch::Tensor* conv = find(weights, "upsample.0.weight", 4, file)) {
+  } else if (const torch::Tensor* conv = find_weight(weights, "upsample.0.weight", 4, file)) {
     config.upsampler = SwinIRUpsampler::PixelShuffleDirect;
     const int64_t out = conv->size(0);
     config.scale = int(std::lround(std::sqrt(double(out) / 3)));
@@ -372,7 +364,7 @@ SwinIRConfig swinir_s_config(int scale) {
 }
 
 SwinIRConfig infer_swinir_config(const StateDict& weights, const std::filesystem::path& file) {
-  const torch::Tensor* first = find(weights, "conv_first.weight", 4, file);
+  const torch::Tensor* first = find_weight(weights, "conv_first.weight", 4, file);
   if (!first || first->size(1) != 3)
     fail_file(file, "not an RGB SwinIR checkpoint: no conv_first.weight of shape (C, 3, 3, 3)");
   SwinIRConfig config;

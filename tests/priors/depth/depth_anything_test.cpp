@@ -4,19 +4,21 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <map>
-#include <sstream>
 
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "io/npy.hpp"
 #include "support/expect_error.hpp"
+#include "support/module_shapes.hpp"
 
 namespace iesrgs::priors::depth {
 namespace {
 
 using testing::error_message;
+using testing::parameter_shapes;
+using testing::ParameterShapes;
+using testing::read_parameter_shapes;
 
 const std::filesystem::path kData = std::filesystem::path(IESRGS_TEST_DATA) / "priors" / "depth";
 
@@ -110,30 +112,11 @@ TEST(DepthAnything, SlicedAttentionEqualsWholeAttention) {
   EXPECT_LT(max_abs_difference(sliced(x), whole(x)), 1e-6f);
 }
 
-// "name dim0 dim1 ..." per entry, as make_fixtures.py writes them from the official class.
-std::map<std::string, std::vector<int64_t>> read_names(const std::string& name) {
-  std::ifstream in(kData / name);
-  std::map<std::string, std::vector<int64_t>> entries;
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream fields(line);
-    std::string key;
-    fields >> key;
-    std::vector<int64_t>& shape = entries[key];
-    for (int64_t d; fields >> d;) shape.push_back(d);
-  }
-  return entries;
-}
-
 TEST(DepthAnything, VitsHasTheOfficialNamesAndShapes) {
-  const std::map<std::string, std::vector<int64_t>> expected = read_names("vits_names.txt");
+  const ParameterShapes expected = read_parameter_shapes(kData / "vits_names.txt");
   ASSERT_EQ(expected.size(), 239u);
-  std::map<std::string, std::vector<int64_t>> actual;
-  const DepthAnythingV2 model(depth_anything_config("vits"));
-  for (const auto& entry : model->named_parameters())
-    actual[entry.key()] = entry.value().sizes().vec();
-  for (const auto& entry : model->named_buffers())
-    actual[entry.key()] = entry.value().sizes().vec();
-  EXPECT_EQ(actual, expected);
+  DepthAnythingV2 model(depth_anything_config("vits"));
+  EXPECT_EQ(parameter_shapes(*model), expected);
 }
 
 TEST(DepthAnything, EncoderIsJudgedByTheEmbeddingWidth) {

@@ -2,14 +2,12 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
-#include "io/npy.hpp"
+#include "priors/sr/sr_test_support.hpp"
 #include "support/expect_error.hpp"
+#include "support/module_shapes.hpp"
 
 // Fixtures come from tests/data/priors/swinir/make_fixtures.py, which runs the authors'
 // network_swinir.py: small official-layout networks with seeded weights, their input and
@@ -19,47 +17,12 @@ namespace iesrgs::priors::sr {
 namespace {
 
 using iesrgs::testing::error_message;
+using iesrgs::testing::parameter_shapes;
+using iesrgs::testing::read_parameter_shapes;
+using iesrgs::testing::zero_state_dict;
+using sr_testing::read_npy_tensor;
 
 const std::filesystem::path kData = std::filesystem::path(IESRGS_TEST_DATA) / "priors/swinir";
-
-using Shapes = std::map<std::string, std::vector<int64_t>>;
-
-Shapes read_shapes(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  EXPECT_TRUE(in) << file;
-  Shapes shapes;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream fields(line);
-    std::string name;
-    fields >> name;
-    int64_t dim = 0;
-    while (fields >> dim) shapes[name].push_back(dim);
-  }
-  return shapes;
-}
-
-Shapes shapes_of(torch::nn::Module& module) {
-  Shapes shapes;
-  for (const auto& item : module.named_parameters())
-    shapes[item.key()] = item.value().sizes().vec();
-  for (const auto& item : module.named_buffers()) shapes[item.key()] = item.value().sizes().vec();
-  return shapes;
-}
-
-// A state dict with the module's layout; only shapes matter to inference, so no memory is filled.
-StateDict layout_of(torch::nn::Module& module) {
-  StateDict weights;
-  for (const auto& [name, shape] : shapes_of(module))
-    weights[name] = torch::zeros({}).expand(shape);
-  return weights;
-}
-
-torch::Tensor read_npy_tensor(const std::filesystem::path& file) {
-  NpyArray array = read_npy(file);
-  const std::vector<int64_t> shape(array.shape.begin(), array.shape.end());
-  return torch::from_blob(array.data.data(), shape, torch::kFloat).clone();
-}
 
 void expect_same_config(const SwinIRConfig& a, const SwinIRConfig& b) {
   EXPECT_EQ(a.embed_dim, b.embed_dim);
@@ -77,8 +40,8 @@ void expect_same_config(const SwinIRConfig& a, const SwinIRConfig& b) {
 TEST(SwinIR, RealConfigurationsHaveTheOfficialStateDictLayout) {
   SwinIR m(swinir_m_config(4));
   SwinIR s(swinir_s_config(2));
-  EXPECT_EQ(shapes_of(*m), read_shapes(kData / "swinir_m_x4_names.txt"));
-  EXPECT_EQ(shapes_of(*s), read_shapes(kData / "swinir_s_x2_names.txt"));
+  EXPECT_EQ(parameter_shapes(*m), read_parameter_shapes(kData / "swinir_m_x4_names.txt"));
+  EXPECT_EQ(parameter_shapes(*s), read_parameter_shapes(kData / "swinir_s_x2_names.txt"));
   // The parameter counts the official code gives (11.9M as the paper reports for SwinIR-M).
   const auto count = [](SwinIR& net) {
     int64_t total = 0;
@@ -97,7 +60,8 @@ TEST(SwinIR, InfersEveryOfficialClassicalConfigurationFromShapes) {
     SwinIR net(config);
     SCOPED_TRACE("embed_dim " + std::to_string(config.embed_dim) + " x" +
                  std::to_string(config.scale));
-    expect_same_config(infer_swinir_config(layout_of(*net), "net.pth"), config);
+    expect_same_config(infer_swinir_config(zero_state_dict(parameter_shapes(*net)), "net.pth"),
+                       config);
   }
 }
 
@@ -150,7 +114,7 @@ void expect_layout_rejected(const StateDict& weights, const std::string& problem
 
 TEST(SwinIR, RejectsLayoutsItDoesNotRun) {
   SwinIR net(swinir_s_config(2));
-  const StateDict official = layout_of(*net);
+  const StateDict official = zero_state_dict(parameter_shapes(*net));
   expect_layout_rejected({}, "no conv_first.weight");
 
   StateDict real_world = official;
