@@ -75,6 +75,45 @@ void add_training_options(CLI::App& command, TrainingArgs& args, const std::stri
                      what + " training parameter key=value (repeatable; see config.json)");
 }
 
+// What the HR rows train with: stages 3 and 4, which `iesrgs internal` does not run.
+void add_fusion_options(CLI::App& command, RunArgs& args) {
+  pipeline::RunOptions& o = args.options;
+  add_training_options(command, args.fusion, "", "HR model");
+  command
+      .add_option("--texture", args.texture,
+                  "IE-SRGS texture guidance: masked, average, external or internal")
+      ->capture_default_str();
+  command.add_option("--li", o.weights.internal_depth, "Internal depth weight (0 = off)")
+      ->capture_default_str()
+      ->check(kNonNegative);
+  command.add_option("--le", o.weights.external_depth, "External depth weight (0 = off)")
+      ->capture_default_str()
+      ->check(kNonNegative);
+  command.add_option("--dssim", o.weights.dssim_weight, "D-SSIM weight l of the texture loss")
+      ->capture_default_str()
+      ->check(kUnitInterval);
+  command
+      .add_option("--threshold", o.threshold,
+                  "Discrepancy threshold T (default 0.6 synthetic, 0.9 real scenes)")
+      ->check(kNonNegative);
+  command.add_option("--init", o.init, "HR model start: scene (as 3DGS) or internal")
+      ->check(CLI::IsMember({"scene", "internal"}))
+      ->capture_default_str();
+  command
+      .add_option("--rows", args.rows,
+                  "Comparison rows, comma-separated: " + pipeline::describe_rows())
+      ->delimiter(',')
+      ->capture_default_str();
+  command.add_option("--lpips", o.lpips, "LPIPS backbone: alex, vgg or none")
+      ->check(CLI::IsMember({"alex", "vgg", "none"}))
+      ->capture_default_str();
+  command
+      .add_option("--diagnostic-views", o.diagnostic_views,
+                  "Training views in the diagnostics contact sheet")
+      ->capture_default_str()
+      ->check(kNonNegative);
+}
+
 CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
                                const std::string& description, pipeline::StageSelection only) {
   auto args = std::make_shared<RunArgs>();
@@ -86,42 +125,17 @@ CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
   command->add_option("--scale", o.scale, "Super-resolution factor s")->capture_default_str();
   command->add_flag("--input-is-lr", o.input_is_lr,
                     "The scene's images are the LR input (no HR ground truth: render, no metrics)");
-  add_external_options(*command, o.external);
   add_training_options(*command, args->internal, "internal", "Internal (LR) model");
-  add_training_options(*command, args->fusion, "", "HR model");
-  command
-      ->add_option("--texture", args->texture,
-                   "IE-SRGS texture guidance: masked, average, external or internal")
-      ->capture_default_str();
-  command->add_option("--li", o.weights.internal_depth, "Internal depth weight (0 = off)")
-      ->capture_default_str()
-      ->check(kNonNegative);
-  command->add_option("--le", o.weights.external_depth, "External depth weight (0 = off)")
-      ->capture_default_str()
-      ->check(kNonNegative);
-  command->add_option("--dssim", o.weights.dssim_weight, "D-SSIM weight l of the texture loss")
-      ->capture_default_str()
-      ->check(kUnitInterval);
-  command
-      ->add_option("--threshold", o.threshold,
-                   "Discrepancy threshold T (default 0.6 synthetic, 0.9 real scenes)")
-      ->check(kNonNegative);
-  command->add_option("--init", o.init, "HR model start: scene (as 3DGS) or internal")
-      ->check(CLI::IsMember({"scene", "internal"}))
-      ->capture_default_str();
-  command
-      ->add_option("--rows", args->rows,
-                   "Comparison rows, comma-separated: " + pipeline::describe_rows())
-      ->delimiter(',')
-      ->capture_default_str();
-  command->add_option("--lpips", o.lpips, "LPIPS backbone: alex, vgg or none")
-      ->check(CLI::IsMember({"alex", "vgg", "none"}))
-      ->capture_default_str();
-  command
-      ->add_option("--diagnostic-views", o.diagnostic_views,
-                   "Training views in the diagnostics contact sheet")
-      ->capture_default_str()
-      ->check(kNonNegative);
+  const size_t internal_options = command->get_options().size();
+  add_external_options(*command, o.external);
+  add_fusion_options(*command, *args);
+  // `iesrgs internal` takes the other stages' options too, so that one command line serves
+  // every stage, but lists them apart as what they are there.
+  if (only == pipeline::StageSelection::Internal) {
+    const std::vector<CLI::Option*> options = command->get_options();
+    for (size_t i = internal_options; i < options.size(); ++i)
+      options[i]->group("Options of the other stages (accepted, unused here)");
+  }
   command->add_option("--seed", args->seed, "Random seed of both trainings")->capture_default_str();
   add_device_option(*command, args->device);
   command->callback([args, only] { run_pipeline(*args, only); });
