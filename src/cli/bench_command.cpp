@@ -16,6 +16,7 @@
 #include "cli/validators.hpp"
 #include "core/cpu_isa.hpp"
 #include "core/math.hpp"
+#include "core/memory.hpp"
 #include "gs/benchmark_model.hpp"
 #include "gs/model.hpp"
 #include "gs/optimizer.hpp"
@@ -132,6 +133,11 @@ RasterWorkload trained_workload(const RasterBenchArgs& args) {
   return w;
 }
 
+// This benchmark's image and gradient planes (ten floats a pixel) and the rasterizer's own two
+// (final transmittance and contributor count): at a large --scale the frames, not the
+// Gaussians, decide whether the run fits.
+constexpr int64_t kRasterBenchBytesPerPixel = 12 * sizeof(float);
+
 // Stage times of one frame, or their sum over the frames of one timed run.
 struct RasterStageTimes {
   double forward = 0, project = 0, bin = 0, blend = 0, backward = 0;
@@ -157,6 +163,8 @@ void run_raster_bench(const RasterBenchArgs& args) {
   size_t plane = 0;
   for (const RasterCamera<float>& cam : w.cameras)
     plane = std::max(plane, size_t(cam.width) * cam.height);
+  require_memory(int64_t(plane) * kRasterBenchBytesPerPixel,
+                 fmt::format("a {}x{} frame", w.cameras[0].width, w.cameras[0].height));
   const size_t n = size_t(g.count);
   std::vector<float> image(3 * plane), alpha(plane), depth(plane);
   std::vector<int32_t> radii(n);

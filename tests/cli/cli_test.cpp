@@ -31,6 +31,20 @@ TEST(Cli, InfoHelpExplainsTheOptions) {
   EXPECT_TRUE(contains(run.output, "--downscale")) << run.output;
 }
 
+// One command line serves every pipeline stage, but `internal` lists the options it does not use
+// under their own heading, after its own.
+TEST(Cli, InternalHelpSetsTheOtherStagesOptionsApart) {
+  const CliRun run = iesrgs("internal --help");
+  EXPECT_EQ(run.status, 0);
+  const size_t heading = run.output.find("Options of the other stages (accepted, unused here):");
+  ASSERT_NE(heading, std::string::npos) << run.output;
+  EXPECT_LT(run.output.find("--internal-iterations"), heading) << run.output;
+  EXPECT_LT(run.output.find("--seed"), heading) << run.output;
+  for (const char* unused : {"--sr-model", "--iterations", "--threshold", "--rows", "--lpips"})
+    EXPECT_GT(run.output.find(std::string(" ") + unused), heading) << unused;
+  EXPECT_EQ(iesrgs("run --help").output.find("Options of the other stages"), std::string::npos);
+}
+
 TEST(Cli, VersionSaysWhichDeviceAutoTakes) {
   const CliRun run = iesrgs("--version");
   EXPECT_EQ(run.status, 0);
@@ -95,6 +109,14 @@ TEST(Cli, BenchModesPrintTheirTimings) {
   EXPECT_EQ(adam.status, 0) << adam.output;
   EXPECT_TRUE(contains(adam.output, "model: 100 Gaussians (5900 floats)")) << adam.output;
   EXPECT_TRUE(contains(adam.output, "Adam step: ")) << adam.output;
+}
+
+TEST(Cli, BenchRefusesAFrameBeyondTheMachinesMemory) {
+  const CliRun huge = iesrgs("bench raster --gaussians 10 --width 800000 --height 800000");
+  EXPECT_EQ(huge.status, 1);
+  EXPECT_TRUE(contains(last_line(huge.output),
+                       "error: not enough memory: a 800000x800000 frame needs about 28610.2 GiB"))
+      << huge.output;
 }
 
 TEST(Cli, BenchRefusesEmptyWork) {
