@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
+#include <regex>
 
 #include "core/error.hpp"
 #include "io/image_tensor.hpp"
@@ -88,6 +89,17 @@ fs::path checkpoint_file(const std::string& model, int scale, const fs::path& we
 
 using Factory = std::function<std::unique_ptr<SrNet>(const fs::path& weights, int scale)>;
 
+// Refuses a checkpoint whose name states another scale than `scale`. The layout cannot always
+// tell: PAN's x2 and x3 files have the same names and shapes, and either would run at the other's
+// scale without a word.
+void check_scale_in_name(const fs::path& file, int scale) {
+  const int stated = scale_in_file_name(file);
+  if (stated != 0 && stated != scale)
+    fail_file(file, fmt::format("its name says x{}, but x{} was requested (rename the file if it "
+                                "really is a x{} checkpoint)",
+                                stated, scale, scale));
+}
+
 // A network whose configuration is the released one at any scale.
 template <class Net, class Options>
 Factory network(const std::string& model) {
@@ -96,6 +108,7 @@ Factory network(const std::string& model) {
     options.scale = scale;
     Net net(options);
     const fs::path file = checkpoint_file(model, scale, weights);
+    check_scale_in_name(file, scale);
     load_state_dict(*net, read_state_dict(file), file);
     return std::make_unique<NetworkSr<Net>>(model, std::move(net), scale, 1);
   };
@@ -145,6 +158,19 @@ fs::path default_sr_weights(const std::string& model, int scale) {
   std::transform(upper.begin(), upper.end(), upper.begin(),
                  [](unsigned char c) { return char(std::toupper(c)); });
   return default_weights_dir() / "sr" / fmt::format("{}_x{}.pth", upper, scale);
+}
+
+int scale_in_file_name(const fs::path& file) {
+  static const std::regex token("(^|[^a-z])x([1-9])(?![0-9])");
+  const std::string stem = file.stem().string();
+  int stated = 0;
+  for (auto it = std::sregex_iterator(stem.begin(), stem.end(), token);
+       it != std::sregex_iterator(); ++it) {
+    const int scale = std::stoi((*it)[2].str());
+    if (stated != 0 && scale != stated) return 0;
+    stated = scale;
+  }
+  return stated;
 }
 
 const std::vector<std::string>& sr_model_names() {

@@ -19,6 +19,11 @@ std::filesystem::path default_sr_weights(const std::string& model, int scale);
 // the default location, else the best installed ESRGAN package (thick, then slim), else bicubic.
 std::string auto_sr_model(int scale);
 
+// The scale a checkpoint's file name states, as the authors name them (PANx2_DF2K.pth,
+// IMDN_x4.pth: an "x" and one digit, not after a lowercase letter), or 0 when it states none or
+// several different ones.
+int scale_in_file_name(const std::filesystem::path& file);
+
 // The names make_sr_net accepts.
 const std::vector<std::string>& sr_model_names();
 

@@ -37,6 +37,22 @@ TEST(SrRegistry, UnknownModelAndBadScaleAreErrors) {
   EXPECT_EQ(error_message([] { make_sr_net("pan", {}, 0); }), "pan: invalid scale 0");
 }
 
+TEST(SrRegistry, ReadsTheScaleThatACheckpointsNameStates) {
+  const std::map<std::string, int> names = {
+      {"PANx2_DF2K.pth", 2},   {"IMDN_x4.pth", 4}, {"SAFMN_DF2K_x3.pth", 3},
+      {"dir_x2/x8.pth", 8},    {"max3.pth", 0},    {"model.pth", 0},
+      {"a_x2_then_x4.pth", 0}, {"PAN_x12.pth", 0}, {"tuned_x4_again_x4.pth", 4}};
+  for (const auto& [name, scale] : names) EXPECT_EQ(scale_in_file_name(name), scale) << name;
+}
+
+// PAN's x2 and x3 files share one layout: only the name can stop one running at the other's scale.
+TEST(SrRegistry, RefusesACheckpointWhoseNameStatesAnotherScale) {
+  const auto file = sr_testing::kFixtures / "tiny_pan_x2.pth";
+  const std::string message = error_message([&] { make_sr_net("pan", file, 3); });
+  EXPECT_TRUE(contains(message, file.string() + ": its name says x2, but x3 was requested"))
+      << message;
+}
+
 TEST(SrRegistry, DefaultWeightsFollowTheEnvironment) {
   ScopedEnv weights("IESRGS_WEIGHTS_DIR", "/opt/weights");
   EXPECT_EQ(default_sr_weights("safmn", 4), "/opt/weights/sr/SAFMN_x4.pth");
