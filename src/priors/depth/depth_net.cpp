@@ -38,6 +38,14 @@ std::unique_ptr<DepthNet> make_depth_net(const std::string& model,
   if (weights.empty())
     fail("{} needs the authors' checkpoint (depth_anything_v2_{}.pth) as its weights", model,
          requested.empty() ? "vitl" : requested);
+  // The metric models have the relative models' names and shapes, so only the file name tells:
+  // their head ends in a sigmoid times max_depth where the relative one has a ReLU.
+  if (weights.filename().string().find("metric") != std::string::npos)
+    fail_file(
+        weights,
+        "a Depth Anything V2 metric-depth checkpoint, which this build does not run (its head "
+        "differs from the relative model's only in layers without weights); the depth prior "
+        "is relative: use the authors' depth_anything_v2_<encoder>.pth");
   const StateDict state = read_state_dict(weights);
   const std::string encoder = depth_anything_encoder(state, weights);
   if (!requested.empty() && encoder != requested)

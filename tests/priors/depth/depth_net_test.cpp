@@ -39,5 +39,14 @@ TEST(MakeDepthNet, UnreadableOrForeignCheckpointsNameTheFile) {
   EXPECT_TRUE(contains(message, kTiny.string() + ": embedding width 24")) << message;
 }
 
+// The metric models share the relative ones' names and shapes but not their output: refused
+// before anything is read, by the name the authors gave them.
+TEST(MakeDepthNet, MetricCheckpointsAreRefusedByName) {
+  const std::filesystem::path metric = "/nowhere/depth_anything_v2_metric_hypersim_vits.pth";
+  const std::string message = error_message([&] { make_depth_net("depth-anything-v2", metric); });
+  EXPECT_TRUE(contains(message, metric.string() + ": a Depth Anything V2 metric-depth checkpoint"))
+      << message;
+}
+
 }  // namespace
 }  // namespace iesrgs::priors::depth
