@@ -37,8 +37,11 @@ std::string config_problem(const SwinIRConfig& config) {
     return fmt::format("window size {} is outside 2..{}", config.window_size, kMaxWindow);
   const bool stacked_scale = is_power_of_two(config.scale) || config.scale == 3;
   if (config.scale < 2 || config.scale > kMaxScale ||
-      (config.upsampler == SwinIRUpsampler::PixelShuffle && !stacked_scale))
+      (config.upsampler == SwinIRUpsampler::PixelShuffle && !stacked_scale) ||
+      (config.upsampler == SwinIRUpsampler::NearestConv && config.scale != 2 && config.scale != 4))
     return fmt::format("scale x{} is not supported by this upsampler", config.scale);
+  if (config.three_conv && config.embed_dim < 4)
+    return "a '3conv' bottleneck needs an embedding width of at least 4";
   return {};
 }
 
@@ -98,10 +101,18 @@ torch::Tensor shifted_window_mask(int64_t height, int64_t width, int64_t window)
 
 // Channels-last weights make oneDNN keep activations channels-last, which is the layout the
 // tokens already have; loading copies into them and keeps it.
-torch::nn::Conv2d conv3x3(int64_t in, int64_t out) {
-  torch::nn::Conv2d conv = same_conv(in, out, 3, /*bias=*/true);
+torch::nn::Conv2d channels_last_conv(int64_t in, int64_t out, int64_t kernel) {
+  torch::nn::Conv2d conv = same_conv(in, out, kernel, /*bias=*/true);
   conv->weight.set_data(conv->weight.contiguous(torch::MemoryFormat::ChannelsLast));
   return conv;
+}
+
+torch::nn::Conv2d conv3x3(int64_t in, int64_t out) {
+  return channels_last_conv(in, out, 3);
+}
+
+torch::nn::LeakyReLU leaky_relu(double slope) {
+  return torch::nn::LeakyReLU(torch::nn::LeakyReLUOptions().negative_slope(slope));
 }
 
 class WindowAttentionImpl : public torch::nn::Module {
@@ -186,7 +197,7 @@ class ResidualGroupImpl : public torch::nn::Module {
     auto group = register_module("residual_group", std::make_shared<torch::nn::Module>());
     blocks_ = group->register_module("blocks", torch::nn::ModuleList());
     for (int64_t i = 0; i < depth; ++i) blocks_->push_back(SwinBlock(config, heads, i % 2 == 1));
-    conv_ = register_module("conv", conv3x3(config.embed_dim, config.embed_dim));
+    conv_ = ResidualConv(*this, "conv", config.embed_dim, config.three_conv);
   }
 
   torch::Tensor forward(const torch::Tensor& tokens, int64_t height, int64_t width,
@@ -199,7 +210,7 @@ class ResidualGroupImpl : public torch::nn::Module {
 
  private:
   torch::nn::ModuleList blocks_{nullptr};
-  torch::nn::Conv2d conv_{nullptr};
+  ResidualConv conv_;
 };
 TORCH_MODULE(ResidualGroup);
 
@@ -277,14 +288,14 @@ int stacked_upsample_scale(const StateDict& weights, const std::filesystem::path
 
 void infer_reconstruction(const StateDict& weights, const std::filesystem::path& file,
                           SwinIRConfig& config) {
-  if (!has(weights, "conv_after_body.weight"))
-    fail_file(file,
-              "unsupported SwinIR layout: conv_after_body is not a single convolution "
-              "(resi_connection '3conv')");
-  if (has(weights, "conv_up1.weight"))
-    fail_file(file, "unsupported SwinIR upsampler 'nearest+conv' (real-world SR)");
-  if (const torch::Tensor* before =
-          find_weight(weights, "conv_before_upsample.0.weight", 4, file)) {
+  config.three_conv = has(weights, "conv_after_body.0.weight");
+  const torch::Tensor* before = find_weight(weights, "conv_before_upsample.0.weight", 4, file);
+  if (has(weights, "conv_up1.weight")) {
+    if (!before) fail_file(file, "a 'nearest+conv' upsampler without conv_before_upsample.0");
+    config.upsampler = SwinIRUpsampler::NearestConv;
+    config.num_feat = before->size(0);
+    config.scale = has(weights, "conv_up2.weight") ? 4 : 2;
+  } else if (before) {
     config.upsampler = SwinIRUpsampler::PixelShuffle;
     config.num_feat = before->size(0);
     config.scale = stacked_upsample_scale(weights, file, config.num_feat);
@@ -355,6 +366,23 @@ SwinIRConfig official_config(int embed_dim, int layers, SwinIRUpsampler upsample
 
 }  // namespace
 
+ResidualConv::ResidualConv(torch::nn::Module& owner, const std::string& name, int64_t dim,
+                           bool three_conv) {
+  if (!three_conv) {
+    single_ = owner.register_module(name, conv3x3(dim, dim));
+    return;
+  }
+  const int64_t narrow = dim / 4;
+  bottleneck_ =
+      owner.register_module(name, torch::nn::Sequential(conv3x3(dim, narrow), leaky_relu(0.2),
+                                                        channels_last_conv(narrow, narrow, 1),
+                                                        leaky_relu(0.2), conv3x3(narrow, dim)));
+}
+
+torch::Tensor ResidualConv::operator()(const torch::Tensor& x) const {
+  return single_ ? single_.ptr()->forward(x) : bottleneck_.ptr()->forward(x);
+}
+
 SwinIRConfig swinir_m_config(int scale) {
   return official_config(180, 6, SwinIRUpsampler::PixelShuffle, scale);
 }
@@ -388,14 +416,21 @@ SwinIRImpl::SwinIRImpl(SwinIRConfig config) : config_(std::move(config)) {
   for (size_t i = 0; i < config_.depths.size(); ++i)
     layers_->push_back(ResidualGroup(config_, config_.depths[i], config_.num_heads[i]));
   norm_ = register_module("norm", torch::nn::LayerNorm(torch::nn::LayerNormOptions({dim})));
-  conv_after_body_ = register_module("conv_after_body", conv3x3(dim, dim));
-  if (config_.upsampler == SwinIRUpsampler::PixelShuffle) {
+  conv_after_body_ = ResidualConv(*this, "conv_after_body", dim, config_.three_conv);
+  if (config_.upsampler != SwinIRUpsampler::PixelShuffleDirect) {
     conv_before_upsample_ = register_module(
         "conv_before_upsample",
         torch::nn::Sequential(conv3x3(dim, config_.num_feat), torch::nn::LeakyReLU()));
     conv_last_ = register_module("conv_last", conv3x3(config_.num_feat, 3));
   }
-  upsample_ = register_module("upsample", upsample_stages(config_));
+  if (config_.upsampler != SwinIRUpsampler::NearestConv) {
+    upsample_ = register_module("upsample", upsample_stages(config_));
+    return;
+  }
+  for (int reached = 1, i = 1; reached < config_.scale; reached *= 2, ++i)
+    up_convs_.push_back(
+        register_module(fmt::format("conv_up{}", i), conv3x3(config_.num_feat, config_.num_feat)));
+  conv_hr_ = register_module("conv_hr", conv3x3(config_.num_feat, config_.num_feat));
 }
 
 torch::Tensor SwinIRImpl::forward(const torch::Tensor& rgb) {
@@ -417,7 +452,13 @@ torch::Tensor SwinIRImpl::forward(const torch::Tensor& rgb) {
 
 torch::Tensor SwinIRImpl::reconstruct(const torch::Tensor& features) {
   if (config_.upsampler == SwinIRUpsampler::PixelShuffleDirect) return upsample_->forward(features);
-  return conv_last_(upsample_->forward(conv_before_upsample_->forward(features)));
+  torch::Tensor x = conv_before_upsample_->forward(features);
+  if (config_.upsampler == SwinIRUpsampler::PixelShuffle) return conv_last_(upsample_->forward(x));
+  // Nearest-neighbour steps instead of pixel shuffles, against checkerboard artifacts.
+  namespace F = torch::nn::functional;
+  for (torch::nn::Conv2d& conv : up_convs_)
+    x = F::leaky_relu(conv(upsample_nearest(x, 2)), F::LeakyReLUFuncOptions().negative_slope(0.2));
+  return conv_last_(F::leaky_relu(conv_hr_(x), F::LeakyReLUFuncOptions().negative_slope(0.2)));
 }
 
 SwinIRUpscaler::SwinIRUpscaler(SwinIR net) : net_(std::move(net)) {}

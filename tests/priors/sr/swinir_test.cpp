@@ -32,7 +32,8 @@ void expect_same_config(const SwinIRConfig& a, const SwinIRConfig& b) {
   EXPECT_EQ(a.mlp_hidden_dim, b.mlp_hidden_dim);
   EXPECT_EQ(a.upsampler, b.upsampler);
   EXPECT_EQ(a.scale, b.scale);
-  if (a.upsampler == SwinIRUpsampler::PixelShuffle) {
+  EXPECT_EQ(a.three_conv, b.three_conv);
+  if (a.upsampler != SwinIRUpsampler::PixelShuffleDirect) {
     EXPECT_EQ(a.num_feat, b.num_feat);
   }
 }
@@ -85,6 +86,31 @@ TEST(SwinIR, PixelShuffleDirectMatchesOfficialCode) {
   expect_matches_official("tiny_pixelshuffledirect_x3", 3);
 }
 
+// The real-world models' upsampler, at x2 (one nearest step) and at x4 (two) with the large
+// model's '3conv' bottlenecks.
+TEST(SwinIR, NearestConvMatchesOfficialCode) {
+  expect_matches_official("tiny_nearestconv_x2", 2);
+  expect_matches_official("tiny_nearestconv_3conv_x4", 4);
+}
+
+// SwinIR-M and SwinIR-L for real-world SR (003_realSR_BSRGAN_DFO*_s64w8_SwinIR-{M,L}_x4_GAN).
+TEST(SwinIR, InfersTheRealWorldModelsFromTheirLayout) {
+  for (const auto& [names, large] : std::vector<std::pair<std::string, bool>>{
+           {"swinir_real_m_x4", false}, {"swinir_real_l_x4", true}}) {
+    SCOPED_TRACE(names);
+    const auto official = read_parameter_shapes(kData / (names + "_names.txt"));
+    const SwinIRConfig config = infer_swinir_config(zero_state_dict(official), "real.pth");
+    EXPECT_EQ(config.upsampler, SwinIRUpsampler::NearestConv);
+    EXPECT_EQ(config.scale, 4);
+    EXPECT_EQ(config.three_conv, large);
+    EXPECT_EQ(config.embed_dim, large ? 240 : 180);
+    EXPECT_EQ(config.depths.size(), large ? 9u : 6u);
+    EXPECT_EQ(config.num_heads[0], large ? 8 : 6);
+    SwinIR net(config);
+    EXPECT_EQ(parameter_shapes(*net), official);
+  }
+}
+
 TEST(SwinIR, LoadsWithAnExplicitConfiguration) {
   const std::filesystem::path file = kData / "tiny_pixelshuffledirect_x3.pth";
   SwinIRConfig config = swinir_s_config(3);
@@ -117,14 +143,9 @@ TEST(SwinIR, RejectsLayoutsItDoesNotRun) {
   const StateDict official = zero_state_dict(parameter_shapes(*net));
   expect_layout_rejected({}, "no conv_first.weight");
 
-  StateDict real_world = official;
-  real_world["conv_up1.weight"] = torch::zeros({64, 64, 3, 3});
-  expect_layout_rejected(real_world, "'nearest+conv'");
-
-  StateDict three_conv = official;
-  three_conv.erase("conv_after_body.weight");
-  three_conv["conv_after_body.0.weight"] = torch::zeros({15, 60, 3, 3});
-  expect_layout_rejected(three_conv, "'3conv'");
+  StateDict headless = official;
+  headless["conv_up1.weight"] = torch::zeros({64, 64, 3, 3});
+  expect_layout_rejected(headless, "'nearest+conv' upsampler without conv_before_upsample.0");
 
   StateDict denoiser = official;
   denoiser.erase("upsample.0.weight");

@@ -11,7 +11,7 @@ Files written next to this script:
                                      every weight drawn from a fixed seed
     tiny_<upsampler>_x<s>_in.npy     a (1, 3, H, W) input, H or W not a window multiple
     tiny_<upsampler>_x<s>_out.npy    the output of the official test procedure on that input
-    swinir_<m|s>_x<s>_names.txt      "name dim0 dim1 ..." for every state-dict entry of the real
+    swinir_<config>_x<s>_names.txt   "name dim0 dim1 ..." for every state-dict entry of the real
                                      configuration except the attn_mask buffers
 """
 import importlib.util
@@ -35,13 +35,24 @@ TINY = {
         dict(upscale=3, embed_dim=16, depths=[2, 3], num_heads=[2, 4],
              upsampler="pixelshuffledirect"),
         (16, 11)),
+    "tiny_nearestconv_x2": (
+        dict(upscale=2, embed_dim=16, depths=[2], num_heads=[2], upsampler="nearest+conv"),
+        (9, 10)),
+    "tiny_nearestconv_3conv_x4": (
+        dict(upscale=4, embed_dim=16, depths=[2, 2], num_heads=[2, 4], upsampler="nearest+conv",
+             resi_connection="3conv"),
+        (12, 7)),
 }
-# The classical-SR and lightweight-SR settings of the official main_test_swinir.py.
+# The classical-SR, lightweight-SR and real-world-SR settings of the official main_test_swinir.py.
 REAL = {
     "swinir_m_x4": dict(upscale=4, img_size=64, embed_dim=180, depths=[6] * 6, num_heads=[6] * 6,
                         upsampler="pixelshuffle"),
     "swinir_s_x2": dict(upscale=2, img_size=64, embed_dim=60, depths=[6] * 4, num_heads=[6] * 4,
                         upsampler="pixelshuffledirect"),
+    "swinir_real_m_x4": dict(upscale=4, img_size=64, embed_dim=180, depths=[6] * 6,
+                             num_heads=[6] * 6, upsampler="nearest+conv"),
+    "swinir_real_l_x4": dict(upscale=4, img_size=64, embed_dim=240, depths=[6] * 9,
+                             num_heads=[8] * 9, upsampler="nearest+conv", resi_connection="3conv"),
 }
 COMMON = dict(in_chans=3, window_size=WINDOW, img_range=1.0, mlp_ratio=2, resi_connection="1conv")
 
@@ -100,7 +111,7 @@ def official_test(model, img_lq, scale):
 def write_tiny(SwinIR, name, kwargs, size, seed):
     generator = torch.Generator().manual_seed(seed)
     # img_size 16 keeps the stored attn_mask buffers small while shifted windows stay enabled.
-    model = SwinIR(img_size=16, **COMMON, **kwargs).eval()
+    model = SwinIR(img_size=16, **{**COMMON, **kwargs}).eval()
     randomize(model, generator)
     img = torch.rand((1, 3) + size, generator=generator)
     out = official_test(model, img, kwargs["upscale"])
@@ -110,7 +121,7 @@ def write_tiny(SwinIR, name, kwargs, size, seed):
 
 
 def write_names(SwinIR, name, kwargs):
-    model = SwinIR(**COMMON, **kwargs)
+    model = SwinIR(**{**COMMON, **kwargs})
     with open(os.path.join(HERE, name + "_names.txt"), "w") as f:
         for key, value in model.state_dict().items():
             if not key.endswith("attn_mask"):
