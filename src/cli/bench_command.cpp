@@ -160,11 +160,13 @@ void run_raster_bench(const RasterBenchArgs& args) {
   using namespace raster;
   const RasterWorkload w = args.model.empty() ? synthetic_workload(args) : trained_workload(args);
   const GaussianParams<float>& g = w.params;
-  size_t plane = 0;
-  for (const RasterCamera<float>& cam : w.cameras)
-    plane = std::max(plane, size_t(cam.width) * cam.height);
+  const RasterCamera<float>& largest =
+      *std::max_element(w.cameras.begin(), w.cameras.end(), [](const auto& a, const auto& b) {
+        return size_t(a.width) * a.height < size_t(b.width) * b.height;
+      });
+  const size_t plane = size_t(largest.width) * largest.height;
   require_memory(int64_t(plane) * kRasterBenchBytesPerPixel,
-                 fmt::format("a {}x{} frame", w.cameras[0].width, w.cameras[0].height));
+                 fmt::format("a {}x{} frame", largest.width, largest.height));
   const size_t n = size_t(g.count);
   std::vector<float> image(3 * plane), alpha(plane), depth(plane);
   std::vector<int32_t> radii(n);

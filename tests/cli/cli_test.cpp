@@ -40,8 +40,10 @@ TEST(Cli, InternalHelpSetsTheOtherStagesOptionsApart) {
   ASSERT_NE(heading, std::string::npos) << run.output;
   EXPECT_LT(run.output.find("--internal-iterations"), heading) << run.output;
   EXPECT_LT(run.output.find("--seed"), heading) << run.output;
-  for (const char* unused : {"--sr-model", "--iterations", "--threshold", "--rows", "--lpips"})
-    EXPECT_GT(run.output.find(std::string(" ") + unused), heading) << unused;
+  for (const char* unused : {"--sr-model", "--iterations", "--threshold", "--rows", "--lpips"}) {
+    const size_t at = run.output.find(std::string(" ") + unused);
+    EXPECT_TRUE(at != std::string::npos && at > heading) << unused;
+  }
   EXPECT_EQ(iesrgs("run --help").output.find("Options of the other stages"), std::string::npos);
 }
 

@@ -33,7 +33,7 @@ inline ParameterShapes read_parameter_shapes(const std::filesystem::path& file) 
 }
 
 // Parameters and buffers, as a state dict names them.
-inline ParameterShapes parameter_shapes(torch::nn::Module& module) {
+inline ParameterShapes parameter_shapes(const torch::nn::Module& module) {
   ParameterShapes shapes;
   for (const auto& item : module.named_parameters())
     shapes[item.key()] = item.value().sizes().vec();

@@ -161,7 +161,7 @@ fs::path default_sr_weights(const std::string& model, int scale) {
 }
 
 int scale_in_file_name(const fs::path& file) {
-  static const std::regex token("(^|[^a-z])x([1-9])(?![0-9])");
+  static const std::regex token("(^|[^a-z0-9])x([1-9])(?![0-9])");
   const std::string stem = file.stem().string();
   int stated = 0;
   for (auto it = std::sregex_iterator(stem.begin(), stem.end(), token);

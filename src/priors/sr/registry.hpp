@@ -20,8 +20,8 @@ std::filesystem::path default_sr_weights(const std::string& model, int scale);
 std::string auto_sr_model(int scale);
 
 // The scale a checkpoint's file name states, as the authors name them (PANx2_DF2K.pth,
-// IMDN_x4.pth: an "x" and one digit, not after a lowercase letter), or 0 when it states none or
-// several different ones.
+// IMDN_x4.pth: a lowercase "x" and one digit, neither after a lowercase letter or a digit nor
+// before another digit), or 0 when it states none or several different ones.
 int scale_in_file_name(const std::filesystem::path& file);
 
 // The names make_sr_net accepts.

@@ -119,16 +119,6 @@ class AttBlockImpl : public nn::Module {
 };
 TORCH_MODULE(AttBlock);
 
-// to_img.0's output channels, 3 * scale^2 -> scale.
-int64_t scale_from_head(const torch::Tensor& head, const std::filesystem::path& file) {
-  const int64_t channels = head.size(0);
-  const auto scale = int64_t(std::lround(std::sqrt(double(channels) / 3)));
-  if (scale < 1 || 3 * scale * scale != channels)
-    fail_file(file,
-              fmt::format("to_img.0.weight has {} output channels, not 3 * scale^2", channels));
-  return scale;
-}
-
 }  // namespace
 
 // Global response normalization (as in ConvNeXt V2): each channel scaled by its spatial L2 norm
@@ -181,7 +171,7 @@ SafmnOptions infer_safmn_options(const StateDict& weights, const std::filesystem
   // The official width is int(dim * ffn_scale); the middle of the scales that truncate to the
   // file's width gives it back whatever the rounding.
   options.ffn_scale = (double(expansion->size(0)) + 0.5) / double(options.dim);
-  options.scale = scale_from_head(*head, file);
+  options.scale = pixel_shuffle_scale(*head, "to_img.0.weight", file);
   return options;
 }
 

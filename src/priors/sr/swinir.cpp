@@ -16,6 +16,8 @@ using torch::indexing::Slice;
 // Bounds the (window^2)^2 relative-position index a corrupt checkpoint could ask for.
 constexpr int64_t kMaxWindow = 32;
 constexpr int kMaxScale = 8;
+// The LeakyReLU slope of the real-world models' upsampler and of every '3conv' bottleneck.
+constexpr double kRealSrSlope = 0.2;
 
 bool is_power_of_two(int value) {
   return value > 0 && (value & (value - 1)) == 0;
@@ -301,11 +303,7 @@ void infer_reconstruction(const StateDict& weights, const std::filesystem::path&
     config.scale = stacked_upsample_scale(weights, file, config.num_feat);
   } else if (const torch::Tensor* conv = find_weight(weights, "upsample.0.weight", 4, file)) {
     config.upsampler = SwinIRUpsampler::PixelShuffleDirect;
-    const int64_t out = conv->size(0);
-    config.scale = int(std::lround(std::sqrt(double(out) / 3)));
-    if (3 * config.scale * config.scale != out)
-      fail_file(file,
-                fmt::format("upsample.0.weight has {} output channels, not 3 * scale^2", out));
+    config.scale = pixel_shuffle_scale(*conv, "upsample.0.weight", file);
   } else {
     fail_file(file,
               "SwinIR checkpoint without an upsampler (denoising or JPEG artifact "
@@ -373,10 +371,10 @@ ResidualConv::ResidualConv(torch::nn::Module& owner, const std::string& name, in
     return;
   }
   const int64_t narrow = dim / 4;
-  bottleneck_ =
-      owner.register_module(name, torch::nn::Sequential(conv3x3(dim, narrow), leaky_relu(0.2),
-                                                        channels_last_conv(narrow, narrow, 1),
-                                                        leaky_relu(0.2), conv3x3(narrow, dim)));
+  bottleneck_ = owner.register_module(
+      name, torch::nn::Sequential(conv3x3(dim, narrow), leaky_relu(kRealSrSlope),
+                                  channels_last_conv(narrow, narrow, 1), leaky_relu(kRealSrSlope),
+                                  conv3x3(narrow, dim)));
 }
 
 torch::Tensor ResidualConv::operator()(const torch::Tensor& x) const {
@@ -455,10 +453,10 @@ torch::Tensor SwinIRImpl::reconstruct(const torch::Tensor& features) {
   torch::Tensor x = conv_before_upsample_->forward(features);
   if (config_.upsampler == SwinIRUpsampler::PixelShuffle) return conv_last_(upsample_->forward(x));
   // Nearest-neighbour steps instead of pixel shuffles, against checkerboard artifacts.
-  namespace F = torch::nn::functional;
+  const auto leaky = torch::nn::functional::LeakyReLUFuncOptions().negative_slope(kRealSrSlope);
   for (torch::nn::Conv2d& conv : up_convs_)
-    x = F::leaky_relu(conv(upsample_nearest(x, 2)), F::LeakyReLUFuncOptions().negative_slope(0.2));
-  return conv_last_(F::leaky_relu(conv_hr_(x), F::LeakyReLUFuncOptions().negative_slope(0.2)));
+    x = torch::nn::functional::leaky_relu(conv(upsample_nearest(x, 2)), leaky);
+  return conv_last_(torch::nn::functional::leaky_relu(conv_hr_(x), leaky));
 }
 
 SwinIRUpscaler::SwinIRUpscaler(SwinIR net) : net_(std::move(net)) {}

@@ -28,7 +28,7 @@ struct SwinIRConfig {
   std::vector<int64_t> num_heads;  // attention heads per residual group
   int64_t window_size = 8;
   int64_t mlp_hidden_dim = 0;
-  int64_t num_feat = 64;  // reconstruction width; PixelShuffle only
+  int64_t num_feat = 64;  // reconstruction width; not PixelShuffleDirect
   SwinIRUpsampler upsampler = SwinIRUpsampler::PixelShuffle;
   int scale = 0;
   // resi_connection '3conv' (the large real-world model): every residual convolution is a

@@ -115,7 +115,7 @@ TEST(DepthAnything, SlicedAttentionEqualsWholeAttention) {
 TEST(DepthAnything, VitsHasTheOfficialNamesAndShapes) {
   const ParameterShapes expected = read_parameter_shapes(kData / "vits_names.txt");
   ASSERT_EQ(expected.size(), 239u);
-  DepthAnythingV2 model(depth_anything_config("vits"));
+  const DepthAnythingV2 model(depth_anything_config("vits"));
   EXPECT_EQ(parameter_shapes(*model), expected);
 }
 

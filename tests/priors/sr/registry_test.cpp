@@ -38,10 +38,11 @@ TEST(SrRegistry, UnknownModelAndBadScaleAreErrors) {
 }
 
 TEST(SrRegistry, ReadsTheScaleThatACheckpointsNameStates) {
-  const std::map<std::string, int> names = {
-      {"PANx2_DF2K.pth", 2},   {"IMDN_x4.pth", 4}, {"SAFMN_DF2K_x3.pth", 3},
-      {"dir_x2/x8.pth", 8},    {"max3.pth", 0},    {"model.pth", 0},
-      {"a_x2_then_x4.pth", 0}, {"PAN_x12.pth", 0}, {"tuned_x4_again_x4.pth", 4}};
+  const std::map<std::string, int> names = {{"PANx2_DF2K.pth", 2},    {"IMDN_x4.pth", 4},
+                                            {"SAFMN_DF2K_x3.pth", 3}, {"dir_x2/x8.pth", 8},
+                                            {"max3.pth", 0},          {"model.pth", 0},
+                                            {"a_x2_then_x4.pth", 0},  {"PAN_x12.pth", 0},
+                                            {"PAN_64x3.pth", 0},      {"tuned_x4_again_x4.pth", 4}};
   for (const auto& [name, scale] : names) EXPECT_EQ(scale_in_file_name(name), scale) << name;
 }
 

@@ -5,8 +5,8 @@ PyTorch modules, so the C++ networks are checked against the reference implement
     /usr/bin/python3 tests/data/priors/sr/make_sr_fixtures.py OFFICIAL_DIR [SHARED_DATA]
 
 OFFICIAL_DIR holds unmodified copies of the official architecture files, importable as
-    team15_SAFMN.py                      SAFMN, NTIRE 2023 efficient-SR release (sunny2109/SAFMN)
-    safmn_arch.py                  SAFMN, the paper's models (sunny2109/SAFMN, basicsr/archs/)
+    team15_SAFMN.py               SAFMN, NTIRE 2023 efficient-SR release (sunny2109/SAFMN)
+    safmn_arch.py                 SAFMN, the paper's models (sunny2109/SAFMN, basicsr/archs/)
     model/architecture.py, model/block.py                               IMDN (Zheng222/IMDN)
     models/archs/PAN_arch.py, models/archs/arch_util.py     PAN (zhaohengyuan1/PAN, codes/)
 
