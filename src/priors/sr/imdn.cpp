@@ -1,5 +1,9 @@
 #include "priors/sr/imdn.hpp"
 
+#include <fmt/format.h>
+
+#include <string>
+
 #include "core/error.hpp"
 #include "priors/sr/layers.hpp"
 
@@ -78,6 +82,20 @@ class ImdModuleImpl : public nn::Module {
 TORCH_MODULE(ImdModule);
 
 }  // namespace
+
+void check_imdn_release(const StateDict& weights, const std::filesystem::path& file) {
+  const auto other = [&](const std::string& release) {
+    fail_file(file, fmt::format("an {} checkpoint, which this build does not run; the x2, x3 and "
+                                "x4 files (IMDN_x<s>.pth) have the layout it runs",
+                                release));
+  };
+  const auto block = weights.lower_bound("block1.");
+  if (block != weights.end() && block->first.rfind("block1.", 0) == 0)
+    other("IMDN_RTE (the real-time contest network, block*.c* names)");
+  // IMDN_AS has the IMDB blocks, but a strided two-layer fea_conv in front of them.
+  if (weights.count("fea_conv.0.weight")) other("IMDN_AS (RealSR at the input's own size)");
+  if (weights.count("model.0.weight")) other("IMDN_RTC (the real-time x2 network, model.* names)");
+}
 
 ImdnImpl::ImdnImpl(const ImdnOptions& options) {
   const int64_t nf = options.channels;

@@ -6,7 +6,10 @@
 #include <torch/torch.h>
 
 #include <cstdint>
+#include <filesystem>
 #include <vector>
+
+#include "priors/state_dict.hpp"
 
 namespace iesrgs::priors::sr {
 
@@ -14,6 +17,12 @@ struct ImdnOptions {
   int64_t channels = 64;  // at least 16: the attention squeezes a quarter of them 16-fold
   int64_t scale = 4;
 };
+
+// Refuses, by name, the authors' other IMDN releases, whose layouts differ from the x2/x3/x4 one:
+// IMDN_AS (RealSR at the input's size) and the real-time IMDN_RTC and IMDN_RTE. Throws
+// iesrgs::Error naming `file`; a checkpoint of the released layout passes, and the strict load
+// names what any other layout lacks.
+void check_imdn_release(const StateDict& weights, const std::filesystem::path& file);
 
 class ImdnImpl : public torch::nn::Module {
  public:

@@ -88,6 +88,8 @@ fs::path checkpoint_file(const std::string& model, int scale, const fs::path& we
 }
 
 using Factory = std::function<std::unique_ptr<SrNet>(const fs::path& weights, int scale)>;
+// Refuses, naming the file, checkpoints of a release the network does not build.
+using ReleaseCheck = void (*)(const StateDict& weights, const fs::path& file);
 
 // Refuses a checkpoint whose name states another scale than `scale`. The layout cannot always
 // tell: PAN's x2 and x3 files have the same names and shapes, and either would run at the other's
@@ -102,14 +104,16 @@ void check_scale_in_name(const fs::path& file, int scale) {
 
 // A network whose configuration is the released one at any scale.
 template <class Net, class Options>
-Factory network(const std::string& model) {
-  return [model](const fs::path& weights, int scale) {
+Factory network(const std::string& model, ReleaseCheck check_release = nullptr) {
+  return [model, check_release](const fs::path& weights, int scale) {
     Options options;
     options.scale = scale;
     Net net(options);
     const fs::path file = checkpoint_file(model, scale, weights);
     check_scale_in_name(file, scale);
-    load_state_dict(*net, read_state_dict(file), file);
+    const StateDict state = read_state_dict(file);
+    if (check_release) check_release(state, file);
+    load_state_dict(*net, state, file);
     return std::make_unique<NetworkSr<Net>>(model, std::move(net), scale, 1);
   };
 }
@@ -133,7 +137,7 @@ const std::map<std::string, Factory>& factories() {
     std::map<std::string, Factory> models = {
         {"bicubic", [](const fs::path&, int scale) { return make_bicubic(scale); }},
         {"safmn", make_safmn},
-        {"imdn", network<Imdn, ImdnOptions>("imdn")},
+        {"imdn", network<Imdn, ImdnOptions>("imdn", check_imdn_release)},
         {"pan", network<Pan, PanOptions>("pan")},
         {"swinir", [](const fs::path& weights, int scale) { return make_swinir(weights, scale); }},
     };
