@@ -106,13 +106,13 @@ void check_scale_in_name(const fs::path& file, int scale) {
 template <class Net, class Options>
 Factory network(const std::string& model, ReleaseCheck check_release = nullptr) {
   return [model, check_release](const fs::path& weights, int scale) {
-    Options options;
-    options.scale = scale;
-    Net net(options);
     const fs::path file = checkpoint_file(model, scale, weights);
     check_scale_in_name(file, scale);
     const StateDict state = read_state_dict(file);
     if (check_release) check_release(state, file);
+    Options options;
+    options.scale = scale;
+    Net net(options);
     load_state_dict(*net, state, file);
     return std::make_unique<NetworkSr<Net>>(model, std::move(net), scale, 1);
   };
