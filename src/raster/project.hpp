@@ -1,6 +1,6 @@
 #pragma once
 // Projection of one Gaussian to a screen-space splat, and its backward pass, following 3DGS
-// (EWA splatting with the Jacobian clamped at 1.3 x tan(fov / 2)) with Mip-Splatting's 3D
+// (EWA splatting with the Jacobian clamped near the image) with Mip-Splatting's 3D
 // smoothing filter and 2D mip filter, or 3DGS's dilation for models trained without it. The
 // backward pass recomputes the forward intermediates. T is float or double on one Gaussian, or a
 // pack of floats with one Gaussian per SIMD lane (raster/cpu/lanes.hpp), hence no branch on data.
@@ -12,7 +12,9 @@
 namespace iesrgs::raster {
 
 constexpr double kNearPlane = 0.2;  // Gaussians with camera z at or below are culled, as 3DGS
-constexpr double kJacobianClamp = 1.3;
+// The Jacobian is taken no further out than this fraction of the image's half-width (height)
+// beyond each edge: 3DGS's 1.3 x tan(fov / 2) for a centred principal point.
+constexpr double kJacobianMargin = 0.3;
 // Blending thresholds as float constants, so that the double instantiation cuts exactly where
 // the float one does: e.g. two splats at the 0.99 cap leave a transmittance just below 1e-4 in
 // float (the pixel stops) but just above it with a double 0.99.
@@ -130,14 +132,18 @@ IESRGS_HD hd::Mask<T> project(const GaussianRow<T>& g, const RasterCamera<T>& ca
       p.sigma.m[r][c] = s;
     }
 
-  // The clamp keeps the linearization sane for Gaussians far outside the field of view.
-  const T lim_x = T(kJacobianClamp) * T(cam.width) / (T(2) * cam.fx);
-  const T lim_y = T(kJacobianClamp) * T(cam.height) / (T(2) * cam.fy);
+  // The clamp keeps the linearization sane for Gaussians far outside the field of view. Its bounds
+  // are the image edges as seen from the principal point (as gsplat's), so that an off-centre
+  // one does not clamp Gaussians inside the image.
+  const T margin_x = T(kJacobianMargin / 2) * T(cam.width) / cam.fx;
+  const T margin_y = T(kJacobianMargin / 2) * T(cam.height) / cam.fy;
+  const T lo_x = -cam.cx / cam.fx - margin_x, hi_x = (T(cam.width) - cam.cx) / cam.fx + margin_x;
+  const T lo_y = -cam.cy / cam.fy - margin_y, hi_y = (T(cam.height) - cam.cy) / cam.fy + margin_y;
   const T rx = p.view.x / z, ry = p.view.y / z;
-  p.clamped_x = rx < -lim_x || rx > lim_x;
-  p.clamped_y = ry < -lim_y || ry > lim_y;
-  p.tx = hd::min(lim_x, hd::max(-lim_x, rx)) * z;
-  p.ty = hd::min(lim_y, hd::max(-lim_y, ry)) * z;
+  p.clamped_x = rx < lo_x || rx > hi_x;
+  p.clamped_y = ry < lo_y || ry > hi_y;
+  p.tx = hd::min(hi_x, hd::max(lo_x, rx)) * z;
+  p.ty = hd::min(hi_y, hd::max(lo_y, ry)) * z;
   const T j[2][3] = {{cam.fx / z, T(0), -cam.fx * p.tx / (z * z)},
                      {T(0), cam.fy / z, -cam.fy * p.ty / (z * z)}};
   for (int r = 0; r < 2; ++r)

@@ -69,8 +69,11 @@ void expect_variants_agree(const Camera& cam, unsigned seed) {
   EXPECT_LT(max_abs_diff(avx2.render.image, base.render.image), 1e-5);
   EXPECT_LT(max_abs_diff(avx2.render.alpha, base.render.alpha), 1e-5);
   EXPECT_LT(max_abs_diff(avx2.render.depth, base.render.depth), 1e-5);
+  // The variants round differently (fused multiply-adds): in float, the gradients of the needle
+  // and image-covering Gaussians cancel over many pixels and keep about four digits.
+  const double tolerance = sizeof(T) == sizeof(float) ? 2e-4 : 1e-10;
   for (size_t k = 0; k < base.grads.size(); ++k)
-    EXPECT_LT(relative_diff(avx2.grads[k], base.grads[k]), 1e-4) << "gradient group " << k;
+    EXPECT_LT(relative_diff(avx2.grads[k], base.grads[k]), tolerance) << "gradient group " << k;
 }
 
 TEST(RasterCpuIsa, Avx2AgreesWithBaselineOnRandomScenes) {

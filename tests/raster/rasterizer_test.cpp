@@ -111,6 +111,35 @@ TEST(RasterForward, ClassicDilationHasClosedForm) {
   expect_isotropic_closed_form(false);
 }
 
+TEST(RasterForward, CropRendersAsTheSamePixelsOfTheFullImage) {
+  // The right half of the image is a camera whose principal point lies on its left edge. The
+  // Gaussians near its right edge must not be clamped as if they were far outside the view.
+  const Camera full = posed_test_camera(64, 48);
+  Camera crop = full;
+  const int offset = 32;
+  crop.intrinsics.width = full.intrinsics.width - offset;
+  crop.intrinsics.cx -= offset;
+  Scene<double> s;
+  s.sh_degree = 1;
+  std::mt19937 rng(7);
+  for (double u : {0.05, 0.2, 0.35, 0.45, 0.52})
+    for (double v : {-0.3, 0.0, 0.3}) {
+      const double z = 3 + u;
+      s.add(world_point(full, u, v, z), {-2.6, -3.2, -2.9}, random_quat(rng), 1.0,
+            {0.6 * u, -0.4 * v, 0.3}, 0.01, {0.2, -0.1, 0.3, 0.1, 0.2, -0.3, 0.05, 0.1, -0.2});
+    }
+  const KernelRender<double> whole = kernel_render(s, full, kRasterBackground);
+  const KernelRender<double> part = kernel_render(s, crop, kRasterBackground);
+  const Intrinsics& k = crop.intrinsics;
+  const size_t plane = size_t(k.width) * k.height, full_plane = size_t(64) * k.height;
+  for (int c = 0; c < 3; ++c)
+    for (int y = 0; y < k.height; ++y)
+      for (int x = 0; x < k.width; ++x)
+        ASSERT_NEAR(part.image[c * plane + size_t(y) * k.width + x],
+                    whole.image[c * full_plane + size_t(y) * 64 + x + offset], 1e-12)
+            << "channel " << c << " pixel " << x << "," << y;
+}
+
 // Box-averages a (3 or 1, H, W) planar image by an integer factor.
 std::vector<double> box_downsample(const std::vector<double>& in, int width, int height,
                                    int factor) {

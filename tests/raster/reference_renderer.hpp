@@ -64,9 +64,12 @@ inline bool reference_project(const Scene<double>& s, int i, const Camera& cam,
     ratio3d *= s2 / var(a, a);
   }
   const Mat3 sigma = rot * var * rot.transposed();
-  const double lim_x = 1.3 * k.width / (2 * k.fx), lim_y = 1.3 * k.height / (2 * k.fy);
-  const double tx = std::clamp(v.x / v.z, -lim_x, lim_x) * v.z;
-  const double ty = std::clamp(v.y / v.z, -lim_y, lim_y) * v.z;
+  // The Jacobian is clamped 0.3 half-widths beyond the image edges, seen from the principal point.
+  const double margin_x = 0.15 * k.width / k.fx, margin_y = 0.15 * k.height / k.fy;
+  const double tx =
+      std::clamp(v.x / v.z, -k.cx / k.fx - margin_x, (k.width - k.cx) / k.fx + margin_x) * v.z;
+  const double ty =
+      std::clamp(v.y / v.z, -k.cy / k.fy - margin_y, (k.height - k.cy) / k.fy + margin_y) * v.z;
   Mat3 j;  // third row zero
   j.m = {k.fx / v.z, 0, -k.fx * tx / (v.z * v.z), 0, k.fy / v.z, -k.fy * ty / (v.z * v.z), 0, 0, 0};
   const Mat3 t = j * cam.rotation;
