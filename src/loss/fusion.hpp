@@ -8,6 +8,7 @@
 #include <string>
 
 #include "loss/depth_l1.hpp"
+#include "loss/photometric.hpp"
 #include "raster/autograd.hpp"
 
 namespace iesrgs::loss {
@@ -26,9 +27,9 @@ const char* texture_guidance_name(TextureGuidance guidance);
 
 struct FusionWeights {
   TextureGuidance texture = TextureGuidance::Masked;
-  double dssim_weight = 0.2;     // l of L_tex
-  double internal_depth = 1e-3;  // li of L_gem^I; 0 turns the term off
-  double external_depth = 1e-4;  // le of L_gem^E; 0 turns the term off
+  double dssim_weight = kDssimWeight;  // l of L_tex
+  double internal_depth = 1e-3;        // li of L_gem^I; 0 turns the term off
+  double external_depth = 1e-4;        // le of L_gem^E; 0 turns the term off
 };
 
 // One training view's references at the HR camera's resolution. Undefined tensors are terms the

@@ -13,8 +13,6 @@ namespace iesrgs::train {
 
 namespace {
 
-constexpr int64_t kPaperIterations = 30000;
-
 // One list of every field and its JSON name, shared by writing, reading and overriding.
 template <typename Config, typename Visit>
 void visit_fields(Config& c, Visit&& visit) {

@@ -8,6 +8,7 @@
 
 #include "gs/densify.hpp"
 #include "gs/optimizer.hpp"
+#include "loss/photometric.hpp"
 
 namespace iesrgs::train {
 
@@ -16,7 +17,7 @@ struct TrainConfig {
   int64_t iterations = 30000;
   int views_per_iteration = 1;  // MVGS's K: distinct random views summed into one step
   uint64_t seed = 0;
-  double dssim_weight = 0.2;  // loss = (1 - w) * L1 + w * D-SSIM per view
+  double dssim_weight = loss::kDssimWeight;  // loss = (1 - w) * L1 + w * D-SSIM per view
 
   int max_sh_degree = 3;
   int64_t sh_increase_every = 1000;

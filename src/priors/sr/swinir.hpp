@@ -72,7 +72,6 @@ class SwinIRImpl : public torch::nn::Module {
   torch::Tensor reconstruct(const torch::Tensor& features);
 
   SwinIRConfig config_;
-  torch::Tensor mean_;
   torch::nn::Conv2d conv_first_{nullptr};
   torch::nn::LayerNorm patch_norm_{nullptr};
   torch::nn::ModuleList layers_{nullptr};
