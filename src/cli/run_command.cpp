@@ -9,6 +9,7 @@
 #include "cli/scene_options.hpp"
 #include "cli/validators.hpp"
 #include "pipeline/ie_srgs.hpp"
+#include "pipeline/rows.hpp"
 #include "train/config.hpp"
 
 namespace iesrgs::cli {

@@ -21,6 +21,7 @@
 #include "pipeline/fusion_stage.hpp"
 #include "pipeline/internal_stage.hpp"
 #include "pipeline/render_views.hpp"
+#include "pipeline/rows.hpp"
 #include "pipeline/stage_record.hpp"
 #include "pipeline/training_stage.hpp"
 #include "train/progress.hpp"
@@ -32,95 +33,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using loss::TextureGuidance;
-
-// What supervises a row's HR model.
-enum class Source {
-  Internal,       // no HR model: the internal LR model itself, rendered at HR
-  SuperResolved,  // the external (and internal) knowledge
-  Bicubic,        // bicubic-upsampled LR views
-  HighRes,        // the HR ground truth (upper bound)
-};
-
-struct RowSpec {
-  const char* id;
-  const char* label;
-  Source source;
-  TextureGuidance texture;
-  bool internal_depth, external_depth;
-  // The mask from the HR truth instead of D: the internal image wherever it is the closer
-  // reference. What IE-SRGS would reach with a perfect mask; benchmarks only.
-  bool oracle_mask;
-
-  static bool needs_truth(const RowSpec& row) {
-    return row.source == Source::HighRes || row.oracle_mask;
-  }
-};
-
-constexpr RowSpec kRows[] = {
-    {"bicubic", "bicubic-3DGS", Source::Bicubic, TextureGuidance::External, false, false, false},
-    {"internal", "internal only (LR Mip-Splatting at HR)", Source::Internal,
-     TextureGuidance::External, false, false, false},
-    {"external", "external only (2D SR -> 3DGS)", Source::SuperResolved, TextureGuidance::External,
-     false, false, false},
-    {"external-depth", "+ E_depth", Source::SuperResolved, TextureGuidance::External, false, true,
-     false},
-    {"joint", "+ I_image (averaged, no mask)", Source::SuperResolved, TextureGuidance::Average,
-     false, true, false},
-    {"joint-depth", "+ I_depth", Source::SuperResolved, TextureGuidance::Average, true, true,
-     false},
-    {"ie-srgs", "IE-SRGS (+ mask)", Source::SuperResolved, TextureGuidance::Masked, true, true,
-     false},
-    {"mask-oracle", "IE-SRGS with the oracle mask (from the HR truth)", Source::SuperResolved,
-     TextureGuidance::Masked, true, true, true},
-    {"hr", "HR upper bound", Source::HighRes, TextureGuidance::External, false, false, false},
-};
-
-const RowSpec* find_row(const std::string& id) {
-  for (const RowSpec& row : kRows)
-    if (id == row.id) return &row;
-  return nullptr;
-}
-
-const RowSpec& row_spec(const std::string& id) {
-  if (const RowSpec* row = find_row(id)) return *row;
-  fail("unknown row '{}'; rows: {}", id, describe_rows());
-}
-
-size_t table_position(const std::string& id) {
-  return size_t(find_row(id) - std::begin(kRows));
-}
-
-nlohmann::json row_json(const RowResult& row) {
-  nlohmann::json entry = {{"row", row.id},
-                          {"label", row.label},
-                          {"train_seconds", row.train_seconds},
-                          {"fps", row.fps}};
-  if (row.from_earlier_run) entry["from_earlier_run"] = true;
-  if (row.evaluated) {
-    entry["psnr"] = row.mean.psnr;
-    entry["ssim"] = row.mean.ssim;
-    if (row.mean.lpips) entry["lpips"] = *row.mean.lpips;
-  }
-  return entry;
-}
-
-// A row of an earlier results.json, which names it; kept only under the current settings, so its
-// label is the one they give.
-RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry) {
-  RowResult row;
-  row.id = spec.id;
-  row.label = std::move(label);
-  row.from_earlier_run = true;
-  row.train_seconds = entry.value("train_seconds", 0.0);
-  row.fps = entry.value("fps", 0.0);
-  row.evaluated = entry.contains("psnr") && entry.contains("ssim");
-  if (row.evaluated) {
-    row.mean.psnr = entry.value("psnr", 0.0);
-    row.mean.ssim = entry.value("ssim", 0.0);
-    if (entry.contains("lpips")) row.mean.lpips = entry.value("lpips", 0.0);
-  }
-  return row;
-}
 
 double elapsed_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -617,71 +529,7 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
   });
 }
 
-std::string format_metric(const RowResult& row, double value, int decimals) {
-  return row.evaluated ? fmt::format("{:.{}f}", value, decimals) : "-";
-}
-
-std::string results_markdown(const RunResult& result) {
-  std::string md =
-      "| row | PSNR | SSIM | LPIPS | HR training | FPS at HR |\n|---|---|---|---|---|---|\n";
-  bool earlier = false;
-  for (const RowResult& row : result.rows) {
-    earlier = earlier || row.from_earlier_run;
-    md += fmt::format("| {}{} | {} | {} | {} | {} | {:.1f} |\n", row.label,
-                      row.from_earlier_run ? " *" : "", format_metric(row, row.mean.psnr, 2),
-                      format_metric(row, row.mean.ssim, 4),
-                      row.mean.lpips ? fmt::format("{:.4f}", *row.mean.lpips) : "-",
-                      train::format_duration(row.train_seconds), row.fps);
-  }
-  if (earlier) md += "\n\\* from an earlier run in this folder with the same settings\n";
-  return md;
-}
-
-void write_results(const fs::path& dir, const RunResult& result) {
-  nlohmann::json json = {{"stages", result.stages},
-                         {"evaluation", result.evaluation},
-                         {"rows", nlohmann::json::array()}};
-  std::string csv = "row,label,psnr,ssim,lpips,train_seconds,fps\n";
-  for (const RowResult& row : result.rows) {
-    json["rows"].push_back(row_json(row));
-    csv += fmt::format("{},\"{}\",{},{},{},{},{}\n", row.id, row.label,
-                       format_metric(row, row.mean.psnr, 4), format_metric(row, row.mean.ssim, 5),
-                       row.mean.lpips ? fmt::format("{:.5f}", *row.mean.lpips) : "",
-                       row.train_seconds, row.fps);
-  }
-  write_file_atomically(dir / "results.json", json.dump(2) + "\n");
-  write_file_atomically(dir / "results.csv", csv);
-  write_file_atomically(dir / "results.md", results_markdown(result));
-}
-
 }  // namespace
-
-std::vector<std::string> expand_rows(const std::vector<std::string>& names) {
-  std::vector<bool> wanted(std::size(kRows), false);
-  for (const std::string& name : names) {
-    for (size_t i = 0; i < std::size(kRows); ++i) {
-      const std::string id = kRows[i].id;
-      const bool ablation = id != "bicubic" && id != "hr" && id != "mask-oracle";
-      const bool demo = id == "bicubic" || id == "internal" || id == "external" || id == "ie-srgs";
-      if (name == id || name == "all" || (name == "ablation" && ablation) ||
-          (name == "demo" && demo))
-        wanted[i] = true;
-    }
-    if (name != "all" && name != "ablation" && name != "demo") row_spec(name);  // validates
-  }
-  std::vector<std::string> rows;
-  for (size_t i = 0; i < std::size(kRows); ++i)
-    if (wanted[i]) rows.push_back(kRows[i].id);
-  if (rows.empty()) fail("--rows: no row selected");
-  return rows;
-}
-
-std::string describe_rows() {
-  std::string text;
-  for (const RowSpec& row : kRows)
-    text += fmt::format("{}{} ({})", text.empty() ? "" : ", ", row.id, row.label);
-  return text + "; groups: demo, ablation, all";
-}
 
 RunResult run_ie_srgs(const RunOptions& options) {
   Pipeline pipeline(options);

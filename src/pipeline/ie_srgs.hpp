@@ -10,10 +10,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "eval/metrics.hpp"
 #include "io/scene.hpp"
 #include "loss/fusion.hpp"
 #include "pipeline/external_stage.hpp"
+#include "pipeline/results.hpp"
 #include "train/config.hpp"
 
 namespace iesrgs::pipeline {
@@ -41,27 +41,6 @@ struct RunOptions {
   int diagnostic_views = 4;
   StageSelection only = StageSelection::All;
   std::filesystem::path output;
-};
-
-// Row names in table order, with the groups "demo" (bicubic, internal, external, ie-srgs),
-// "ablation" and "all" expanded. Throws Error for an unknown name.
-std::vector<std::string> expand_rows(const std::vector<std::string>& names);
-// "name (what it is)" for every row, and the groups, for --help.
-std::string describe_rows();
-
-struct RowResult {
-  std::string id, label;
-  eval::ViewMetrics mean;  // over the test views; evaluated only with ground truth
-  bool evaluated = false;
-  double train_seconds = 0;       // the row's own HR training (internal only: the LR model's)
-  double fps = 0;                 // test-view rendering at HR
-  bool from_earlier_run = false;  // kept from the folder's table, not run by this command
-};
-
-struct RunResult {
-  std::vector<RowResult> rows;
-  nlohmann::json stages;      // seconds per stage
-  nlohmann::json evaluation;  // what the rows were scored against: test views' digest, LPIPS net
 };
 
 // Runs the selected stages and writes <output>/results.{json,csv,md} after the rows, keeping the

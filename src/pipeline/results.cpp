@@ -1,0 +1,83 @@
+#include "pipeline/results.hpp"
+
+#include <fmt/core.h>
+
+#include <utility>
+
+#include "io/atomic_file.hpp"
+#include "train/progress.hpp"
+
+namespace iesrgs::pipeline {
+
+namespace {
+
+nlohmann::json row_json(const RowResult& row) {
+  nlohmann::json entry = {{"row", row.id},
+                          {"label", row.label},
+                          {"train_seconds", row.train_seconds},
+                          {"fps", row.fps}};
+  if (row.from_earlier_run) entry["from_earlier_run"] = true;
+  if (row.evaluated) {
+    entry["psnr"] = row.mean.psnr;
+    entry["ssim"] = row.mean.ssim;
+    if (row.mean.lpips) entry["lpips"] = *row.mean.lpips;
+  }
+  return entry;
+}
+
+std::string format_metric(const RowResult& row, double value, int decimals) {
+  return row.evaluated ? fmt::format("{:.{}f}", value, decimals) : "-";
+}
+
+}  // namespace
+
+RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry) {
+  RowResult row;
+  row.id = spec.id;
+  row.label = std::move(label);
+  row.from_earlier_run = true;
+  row.train_seconds = entry.value("train_seconds", 0.0);
+  row.fps = entry.value("fps", 0.0);
+  row.evaluated = entry.contains("psnr") && entry.contains("ssim");
+  if (row.evaluated) {
+    row.mean.psnr = entry.value("psnr", 0.0);
+    row.mean.ssim = entry.value("ssim", 0.0);
+    if (entry.contains("lpips")) row.mean.lpips = entry.value("lpips", 0.0);
+  }
+  return row;
+}
+
+std::string results_markdown(const RunResult& result) {
+  std::string md =
+      "| row | PSNR | SSIM | LPIPS | HR training | FPS at HR |\n|---|---|---|---|---|---|\n";
+  bool earlier = false;
+  for (const RowResult& row : result.rows) {
+    earlier = earlier || row.from_earlier_run;
+    md += fmt::format("| {}{} | {} | {} | {} | {} | {:.1f} |\n", row.label,
+                      row.from_earlier_run ? " *" : "", format_metric(row, row.mean.psnr, 2),
+                      format_metric(row, row.mean.ssim, 4),
+                      row.mean.lpips ? fmt::format("{:.4f}", *row.mean.lpips) : "-",
+                      train::format_duration(row.train_seconds), row.fps);
+  }
+  if (earlier) md += "\n\\* from an earlier run in this folder with the same settings\n";
+  return md;
+}
+
+void write_results(const std::filesystem::path& dir, const RunResult& result) {
+  nlohmann::json json = {{"stages", result.stages},
+                         {"evaluation", result.evaluation},
+                         {"rows", nlohmann::json::array()}};
+  std::string csv = "row,label,psnr,ssim,lpips,train_seconds,fps\n";
+  for (const RowResult& row : result.rows) {
+    json["rows"].push_back(row_json(row));
+    csv += fmt::format("{},\"{}\",{},{},{},{},{}\n", row.id, row.label,
+                       format_metric(row, row.mean.psnr, 4), format_metric(row, row.mean.ssim, 5),
+                       row.mean.lpips ? fmt::format("{:.5f}", *row.mean.lpips) : "",
+                       row.train_seconds, row.fps);
+  }
+  write_file_atomically(dir / "results.json", json.dump(2) + "\n");
+  write_file_atomically(dir / "results.csv", csv);
+  write_file_atomically(dir / "results.md", results_markdown(result));
+}
+
+}  // namespace iesrgs::pipeline

@@ -1,0 +1,39 @@
+#pragma once
+// A run's table: its rows' scores, training times and rendering speeds, written as results.json,
+// .csv and .md, and the rows of an earlier table read back.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "eval/metrics.hpp"
+#include "pipeline/rows.hpp"
+
+namespace iesrgs::pipeline {
+
+struct RowResult {
+  std::string id, label;
+  eval::ViewMetrics mean;  // over the test views; evaluated only with ground truth
+  bool evaluated = false;
+  double train_seconds = 0;       // the row's own HR training (internal only: the LR model's)
+  double fps = 0;                 // test-view rendering at HR
+  bool from_earlier_run = false;  // kept from the folder's table, not run by this command
+};
+
+struct RunResult {
+  std::vector<RowResult> rows;
+  nlohmann::json stages;      // seconds per stage
+  nlohmann::json evaluation;  // what the rows were scored against: test views' digest, LPIPS net
+};
+// A row of an earlier results.json, which names it; kept only under the current settings, so its
+// label is the one they give.
+RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry);
+
+// The table as Markdown; rows without ground truth show "-".
+std::string results_markdown(const RunResult& result);
+
+// Writes <dir>/results.{json,csv,md}, each atomically.
+void write_results(const std::filesystem::path& dir, const RunResult& result);
+
+}  // namespace iesrgs::pipeline
