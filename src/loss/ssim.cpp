@@ -16,8 +16,7 @@ namespace iesrgs::loss {
 namespace {
 
 constexpr int kRadius = kSsimWindow / 2;
-constexpr int kMomentPlanes = 4;   // MomentRows
-constexpr int kPartialPlanes = 3;  // d/d mean, d/d mean square, d/d mean product
+constexpr int kMomentPlanes = 4;  // MomentRows
 
 // The window's taps in the kernels' scalar type.
 template <typename T>
@@ -154,7 +153,7 @@ class ForwardBox {
         padded_x_(in.width + 2 * kRadius, T(0)),
         padded_y_(padded_x_),
         stats_(kMomentPlanes * in.width),
-        points_((1 + kPartialPlanes) * in.width) {}
+        points_((1 + kSsimPartialPlanes) * in.width) {}
 
   // Sum of the per-channel SSIM over the box.
   double run() {
@@ -200,11 +199,11 @@ class ForwardBox {
     const MomentRows<T> stats{s, s + width, s + 2 * width, s + 3 * width};
     in_.rows.sub_window_moments(window<T>().tap, rows[0], rows[1], rows[2], rows[3], width, stats);
 
-    // Value then the kPartialPlanes derivatives, one row each; the derivatives straight into
+    // Value then the kSsimPartialPlanes derivatives, one row each; the derivatives straight into
     // the partials when the backward pass wants them.
     T* values = points_.data();
-    T* d[kPartialPlanes];
-    for (int plane = 0; plane < kPartialPlanes; ++plane)
+    T* d[kSsimPartialPlanes];
+    for (int plane = 0; plane < kSsimPartialPlanes; ++plane)
       d[plane] = partials_ ? partials_ + plane * in_.shape.values() + row_offset(in_.shape, c, r) +
                                  in_.box.col0
                            : values + size_t(1 + plane) * width;
@@ -238,9 +237,9 @@ class BackwardBox {
         partials_(partials),
         weight_(weight),
         grad_x_(grad_x),
-        ring_(kPartialPlanes, in.width),
-        padded_(size_t(kPartialPlanes) * (in.width + 2 * kRadius), T(0)),
-        blurred_(size_t(kPartialPlanes) * in.width) {}
+        ring_(kSsimPartialPlanes, in.width),
+        padded_(size_t(kSsimPartialPlanes) * (in.width + 2 * kRadius), T(0)),
+        blurred_(size_t(kSsimPartialPlanes) * in.width) {}
 
   void run() {
     for (int c = 0; c < in_.shape.channels; ++c)
@@ -257,7 +256,7 @@ class BackwardBox {
     }
     const T inv_channels = T(1) / in_.shape.channels;
     const T* weight = weight_ + size_t(r) * in_.shape.width + in_.span.first;
-    for (int plane = 0; plane < kPartialPlanes; ++plane) {
+    for (int plane = 0; plane < kSsimPartialPlanes; ++plane) {
       T* padded = padded_.data() + size_t(plane) * (in_.width + 2 * kRadius);
       const T* partial =
           partials_ + plane * in_.shape.values() + row_offset(in_.shape, c, r) + in_.span.first;
@@ -273,7 +272,7 @@ class BackwardBox {
 
   void column_pass(int r, int c) {
     const int width = in_.width;
-    for (int plane = 0; plane < kPartialPlanes; ++plane) {
+    for (int plane = 0; plane < kSsimPartialPlanes; ++plane) {
       const T* rows[kSsimWindow];
       ring_.column(r, plane, rows);
       in_.rows.blur(window<T>().tap, rows, width, blurred_.data() + size_t(plane) * width);

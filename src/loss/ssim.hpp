@@ -23,10 +23,12 @@ constexpr double kSsimC2 = 0.03 * 0.03;
 // not faster (docs/BENCHMARKS.md).
 constexpr int kSsimTile = 16;
 
-// Values the partials buffer of ssim() holds: the derivatives of each channel's SSIM with respect
-// to its window mean, mean square and mean product of x (3 x channels x height x width).
+// The partials buffer of ssim() holds, for every value of x, the derivatives of its channel's SSIM
+// with respect to the window mean, mean square and mean product of x: kSsimPartialPlanes planes of
+// channels x height x width, on the CPU and on the GPU.
+constexpr int kSsimPartialPlanes = 3;
 inline size_t ssim_partials_size(const ImageShape& shape) {
-  return 3 * shape.values();
+  return kSsimPartialPlanes * shape.values();
 }
 
 // Mean SSIM of x against y (both CHW). When non-null, `map` receives the per-pixel SSIM averaged

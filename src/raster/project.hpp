@@ -63,7 +63,7 @@ IESRGS_HD GaussianRow<T> gaussian_row(const GaussianParams<T>& g, int i) {
           g.quats + 4 * i,
           g.opacity_logits[i],
           g.filter_std ? g.filter_std[i] : T(0),
-          {g.sh_dc + 3 * i, g.sh_rest + gs::kShRestFloats * i},
+          {g.sh_dc + 3 * i, g.sh_rest + gs::kShRestFloats * size_t(i)},
           g.sh_degree,
           g.antialiased};
 }
@@ -351,7 +351,7 @@ IESRGS_HD void add_row_grad(const GaussianRowGrad<T>& d, int i, const GaussianGr
   for (int k = 0; k < 4; ++k) grads.quats[4 * i + k] += d.quat[k];
   for (int k = 0; k < 3; ++k) grads.sh_dc[3 * i + k] += d.sh_dc[k];
   for (int k = 0; k < gs::kShRestFloats; ++k)
-    grads.sh_rest[gs::kShRestFloats * i + k] += d.sh_rest[k];
+    grads.sh_rest[gs::kShRestFloats * size_t(i) + k] += d.sh_rest[k];
   grads.means[3 * i] += d.mean.x;
   grads.means[3 * i + 1] += d.mean.y;
   grads.means[3 * i + 2] += d.mean.z;

@@ -11,8 +11,7 @@ namespace {
 using iesrgs::cuda::check;
 
 constexpr int kRadius = kSsimWindow / 2;
-constexpr int kMomentPlanes = 4;   // mean x, mean y, spread, cross
-constexpr int kPartialPlanes = 3;  // d/d mean, d/d mean square, d/d mean product
+constexpr int kMomentPlanes = 4;  // mean x, mean y, spread, cross
 const dim3 kBlock(32, 8);
 
 struct Taps {
@@ -127,7 +126,7 @@ __global__ void backward_rows(ImageShape shape, Taps w, const float* partials, c
   const size_t values = shape.values();
   const size_t row_start = (size_t(blockIdx.z) * shape.height + row) * shape.width;
   const float* weight_row = weight + size_t(row) * shape.width;
-  for (int plane = 0; plane < kPartialPlanes; ++plane) {
+  for (int plane = 0; plane < kSsimPartialPlanes; ++plane) {
     const float* partial = partials + plane * values + row_start;
     float sum = 0;
     for (int k = 0; k < kSsimWindow; ++k) {
@@ -146,8 +145,8 @@ __global__ void backward_columns(const float* x, const float* y, ImageShape shap
   if (col >= shape.width || row >= shape.height) return;
   const size_t values = shape.values();
   const size_t channel_start = size_t(blockIdx.z) * shape.height * shape.width;
-  float d[kPartialPlanes];
-  for (int plane = 0; plane < kPartialPlanes; ++plane) {
+  float d[kSsimPartialPlanes];
+  for (int plane = 0; plane < kSsimPartialPlanes; ++plane) {
     d[plane] = 0;
     for (int k = 0; k < kSsimWindow; ++k) {
       const int r = row - kRadius + k;
@@ -179,7 +178,7 @@ void Ssim::backward(const float* x, const float* y, const ImageShape& shape, con
                     const float* weight, float* grad_x) {
   check_shape(shape, "ssim_backward");
   const Taps w = taps();
-  float* blurred = planes_.reserve(kPartialPlanes * shape.values());
+  float* blurred = planes_.reserve(kSsimPartialPlanes * shape.values());
   backward_rows<<<grid(shape, shape.channels), kBlock, 0, stream_>>>(shape, w, partials, weight,
                                                                      blurred);
   backward_columns<<<grid(shape, shape.channels), kBlock, 0, stream_>>>(x, y, shape, w, blurred,

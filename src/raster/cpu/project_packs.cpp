@@ -84,7 +84,8 @@ struct RowLanes {
       opacity_logit.v[l] = g.opacity_logits[i];
       filter_std.v[l] = g.filter_std ? g.filter_std[i] : 0.f;
       for (int k = 0; k < 3; ++k) sh_dc[k].v[l] = g.sh_dc[3 * i + k];
-      for (int k = 0; k < rest_floats; ++k) sh_rest[k].v[l] = g.sh_rest[gs::kShRestFloats * i + k];
+      for (int k = 0; k < rest_floats; ++k)
+        sh_rest[k].v[l] = g.sh_rest[gs::kShRestFloats * size_t(i) + k];
     }
   }
 
