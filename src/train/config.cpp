@@ -135,17 +135,17 @@ void apply_json(TrainConfig& config, const nlohmann::json& json, const std::stri
   }
 }
 
-void apply_assignment(TrainConfig& config, const std::string& assignment) {
+void apply_assignment(TrainConfig& config, const std::string& assignment, const std::string& flag) {
   const size_t eq = assignment.find('=');
-  if (eq == std::string::npos || eq == 0) fail("--set \"{}\": expected key=value", assignment);
+  if (eq == std::string::npos || eq == 0) fail("{} \"{}\": expected key=value", flag, assignment);
   const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
   // The preset names where the schedule came from; setting the name alone would mislabel it.
   if (key == "preset")
-    fail("--set \"{}\": the preset is chosen with --preset, which also sets its schedule",
-         assignment);
+    fail("{} \"{}\": the preset is chosen with {}, which also sets its schedule", flag, assignment,
+         flag.substr(0, flag.size() - 3) + "preset");
   nlohmann::json value = nlohmann::json::parse(text, nullptr, false);
   if (value.is_discarded()) value = text;
-  apply_json(config, nlohmann::json{{key, value}}, "--set " + assignment);
+  apply_json(config, nlohmann::json{{key, value}}, flag + " " + assignment);
 }
 
 void validate(const TrainConfig& c) {

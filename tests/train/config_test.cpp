@@ -80,6 +80,15 @@ TEST(TrainConfig, BadInputNamesTheProblem) {
   // The preset is a record of where the schedule came from, set with --preset.
   EXPECT_NE(error_message([&] { apply_assignment(c, "preset=paper"); }).find("--preset"),
             std::string::npos);
+  // The HR and LR stages of `run` take their overrides from two options; errors name the one used.
+  EXPECT_NE(error_message([&] {
+              apply_assignment(c, "bogus=1", "--internal-set");
+            }).find("--internal-set bogus=1: unknown training parameter \"bogus\""),
+            std::string::npos);
+  EXPECT_NE(error_message([&] {
+              apply_assignment(c, "preset=paper", "--internal-set");
+            }).find("chosen with --internal-preset"),
+            std::string::npos);
   EXPECT_NE(error_message([] { make_preset("turbo"); }).find("turbo"), std::string::npos);
   c.views_per_iteration = 0;
   EXPECT_NE(error_message([&] { validate(c); }).find("views_per_iteration"), std::string::npos);

@@ -36,8 +36,10 @@ std::unique_ptr<DepthNet> make_depth_net(const std::string& model,
   }
   const std::string requested = requested_encoder(model);
   if (weights.empty())
-    fail("{} needs the authors' checkpoint (depth_anything_v2_{}.pth) as its weights", model,
-         requested.empty() ? "vitl" : requested);
+    fail(
+        "{} needs the authors' checkpoint (depth_anything_v2_{}.pth) as its weights: give its "
+        "path with --depth-weights (--weights in iesrgs depth)",
+        model, requested.empty() ? "vitl" : requested);
   // The metric models have the relative models' names and shapes, so only the file name tells:
   // their head ends in a sigmoid times max_depth where the relative one has a ReLU.
   if (weights.filename().string().find("metric") != std::string::npos)

@@ -27,6 +27,7 @@ TEST(MakeDepthNet, UnknownModelIsNamed) {
 TEST(MakeDepthNet, MissingWeightsNameTheExpectedCheckpoint) {
   const std::string message = error_message([] { make_depth_net("depth-anything-v2-vitb", ""); });
   EXPECT_TRUE(contains(message, "depth_anything_v2_vitb.pth")) << message;
+  EXPECT_TRUE(contains(message, "--depth-weights")) << message;
 }
 
 TEST(MakeDepthNet, UnreadableOrForeignCheckpointsNameTheFile) {
