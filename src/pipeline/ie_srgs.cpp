@@ -1,6 +1,7 @@
 #include "pipeline/ie_srgs.hpp"
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
@@ -116,6 +117,8 @@ class Pipeline {
   std::vector<ExternalView> external_, bicubic_;
   std::optional<InternalStage> internal_;
   nlohmann::json stages_ = nlohmann::json::object();
+  // What LPIPS the rows were scored with: the net's name, or why it was not computed.
+  std::string lpips_status_;
 };
 
 namespace {
@@ -352,7 +355,13 @@ RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& mo
   result.id = row.id;
   result.label = row_label(row);
   result.evaluated = !evaluation.report.views.empty();
-  if (result.evaluated) result.mean = evaluation.report.mean();
+  if (result.evaluated) {
+    result.mean = evaluation.report.mean();
+    // The table shows "-" for a missing LPIPS: say once why.
+    if (lpips_status_.empty() && evaluation.report.lpips_status.rfind("unavailable", 0) == 0)
+      spdlog::warn("LPIPS ({}) {}", o_.lpips, evaluation.report.lpips_status);
+    lpips_status_ = evaluation.report.lpips_status;
+  }
   result.fps = evaluation.seconds_per_view > 0 ? 1 / evaluation.seconds_per_view : 0;
   return result;
 }
@@ -470,7 +479,8 @@ RunResult Pipeline::run() {
     internal.train_seconds = internal_->training.seconds;
     result.rows.push_back(internal);
   }
-  result.evaluation = {{"test_views", test_digest_}, {"lpips", o_.lpips}};
+  result.evaluation = {{"test_views", test_digest_},
+                       {"lpips", lpips_status_.empty() ? o_.lpips : lpips_status_}};
   keep_earlier_rows(result);
   stages_["total_seconds_this_run"] = elapsed_since(start);
   result.stages = stages_;

@@ -29,6 +29,32 @@ std::string format_metric(const RowResult& row, double value, int decimals) {
   return row.evaluated ? fmt::format("{:.{}f}", value, decimals) : "-";
 }
 
+// The time of each stage, from `stages` (results.json's), in pipeline order: what the paper's
+// Table 5 reports. A training reused from the cache counts the time it took when it ran; rows
+// kept from an earlier run's table have none.
+std::string stages_markdown(const RunResult& result) {
+  const nlohmann::json& stages = result.stages;
+  std::string md = "| stage | time |\n|---|---|\n";
+  const auto add = [&](const std::string& stage, const nlohmann::json& seconds) {
+    if (seconds.is_number())
+      md += fmt::format("| {} | {} |\n", stage, train::format_duration(seconds.get<double>()));
+  };
+  const auto entry = [&](const char* key, const std::string& row = "") {
+    const nlohmann::json& value = stages.contains(key) ? stages[key] : nlohmann::json();
+    if (row.empty()) return value;
+    return value.is_object() && value.contains(row) ? value[row] : nlohmann::json();
+  };
+  add("external knowledge (E_image, E_depth)", entry("external_seconds"));
+  add("internal model (LR Mip-Splatting)", entry("internal_training_seconds"));
+  add("SR-splatting (I_image, I_depth at HR)", entry("sr_splatting_seconds"));
+  for (const RowResult& row : result.rows)
+    add("HR training, " + row.id, entry("fusion_seconds", row.id));
+  for (const RowResult& row : result.rows)
+    add("rendering and scoring, " + row.id, entry("evaluation_seconds", row.id));
+  add("this run in all", entry("total_seconds_this_run"));
+  return md;
+}
+
 }  // namespace
 
 RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry) {
@@ -60,7 +86,7 @@ std::string results_markdown(const RunResult& result) {
                       train::format_duration(row.train_seconds), row.fps);
   }
   if (earlier) md += "\n\\* from an earlier run in this folder with the same settings\n";
-  return md;
+  return md + "\n" + stages_markdown(result);
 }
 
 void write_results(const std::filesystem::path& dir, const RunResult& result) {

@@ -30,7 +30,7 @@ struct RunResult {
 // label is the one they give.
 RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry);
 
-// The table as Markdown; rows without ground truth show "-".
+// The table as Markdown, then the time per stage; rows without ground truth show "-".
 std::string results_markdown(const RunResult& result);
 
 // Writes <dir>/results.{json,csv,md}, each atomically.

@@ -11,6 +11,7 @@
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "support/cli_run.hpp"
+#include "support/scoped_env.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs {
@@ -20,6 +21,7 @@ using testing::CliRun;
 using testing::contains;
 using testing::iesrgs;
 using testing::last_line;
+using testing::ScopedEnv;
 using testing::TempDir;
 
 // Edits a PNG: every value inverted.
@@ -54,6 +56,22 @@ class RunCli : public ::testing::Test {
   const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
 };
 
+TEST_F(RunCli, SaysOnceWhyLpipsIsMissing) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
+  const ScopedEnv torch_home("TORCH_HOME", (dir / "empty-torch-cache").string());
+  std::string schedule = kTinySchedule;
+  schedule.replace(schedule.find("--lpips none"), 12, "--lpips alex");
+  const CliRun run = iesrgs("run " + scene + " -o " + out + " --rows bicubic,external" + schedule);
+  ASSERT_EQ(run.status, 0) << run.output;
+  const size_t said = run.output.find("LPIPS (alex) unavailable: ");
+  EXPECT_NE(said, std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("LPIPS (alex) unavailable", said + 1), std::string::npos) << run.output;
+  // The table records what the rows were scored with, not what was asked for.
+  const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+  EXPECT_EQ(results["evaluation"]["lpips"].get<std::string>().rfind("unavailable: ", 0), 0u)
+      << results.dump();
+}
+
 TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   ASSERT_EQ(write_scene(48, 6, 2), 0);
   const std::string command =
@@ -77,6 +95,10 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   EXPECT_EQ(results["rows"][5]["row"], "mask-oracle");
   EXPECT_EQ(results["rows"][6]["row"], "hr");
   EXPECT_TRUE(results["stages"].contains("internal_training_seconds"));
+  const std::string markdown = read_file(dir / "run" / "results.md");
+  for (const char* stage : {"| internal model (LR Mip-Splatting) | ", "| HR training, ie-srgs | ",
+                            "| rendering and scoring, internal | ", "| this run in all | "})
+    EXPECT_TRUE(contains(markdown, stage)) << markdown;
   for (const char* file :
        {"results.csv", "results.md", "external/image/r_0.png", "bicubic/image/r_0.png",
         "internal/point_cloud.ply", "internal/sr/rgb/r_0.png", "internal/sr/depth/r_0.npy",
