@@ -11,7 +11,6 @@
 #include "cli/scene_options.hpp"
 #include "cli/validators.hpp"
 #include "core/error.hpp"
-#include "core/paths.hpp"
 #include "eval/lpips.hpp"
 #include "eval/metrics.hpp"
 #include "io/atomic_file.hpp"
@@ -38,12 +37,7 @@ struct EvalArgs {
 std::vector<std::filesystem::path> render_files(std::filesystem::path dir) {
   if (std::filesystem::is_directory(dir / "rgb")) dir /= "rgb";
   if (!std::filesystem::is_directory(dir)) fail_file(dir, "is not a folder of rendered images");
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(dir))
-    if (entry.is_regular_file() && is_image_file(entry.path())) files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
-  if (files.empty()) fail_file(dir, "holds no PNG or JPEG images");
-  return files;
+  return image_files_in(dir);
 }
 
 // Refuses renders that `iesrgs render` made of other cameras than the ground truth's split, as

@@ -2,7 +2,6 @@
 // the registry (bicubic, SAFMN, IMDN, PAN, SwinIR, ...), tiled so large inputs fit in memory.
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -48,11 +47,8 @@ std::vector<Job> folder_jobs(const fs::path& folder, const fs::path& out) {
   if (fs::exists(out) && !fs::is_directory(out))
     fail_file(out, "is a file, but the input is a folder");
   std::vector<Job> jobs;
-  for (const auto& entry : fs::directory_iterator(folder))
-    if (entry.is_regular_file() && is_image_file(entry.path()))
-      jobs.push_back({entry.path(), out / entry.path().stem().concat(".png")});
-  if (jobs.empty()) fail_file(folder, "no PNG or JPEG images in this folder");
-  std::sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.input < b.input; });
+  for (const fs::path& image : image_files_in(folder))
+    jobs.push_back({image, out / image.stem().concat(".png")});
   // a.png and a.jpg would both become a.png, the second overwriting the first.
   std::map<fs::path, fs::path> inputs;
   for (const Job& job : jobs)

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "io/atomic_file.hpp"
 
 namespace iesrgs {
@@ -85,6 +86,15 @@ std::string encode_png(const fs::path& path, const uint8_t* samples, int width, 
 }
 
 }  // namespace
+
+std::vector<fs::path> image_files_in(const fs::path& folder) {
+  std::vector<fs::path> images;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+    if (entry.is_regular_file() && is_image_file(entry.path())) images.push_back(entry.path());
+  if (images.empty()) fail_file(folder, "no PNG or JPEG images in this folder");
+  std::sort(images.begin(), images.end());
+  return images;
+}
 
 ImageHeader read_image_header(const fs::path& path) {
   require_readable(path);

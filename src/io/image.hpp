@@ -26,6 +26,10 @@ struct ImageHeader {
   int width = 0, height = 0, channels = 0;
 };
 
+// The PNG and JPEG files directly inside `folder`, in name order; throws Error naming the folder
+// when it holds none.
+std::vector<std::filesystem::path> image_files_in(const std::filesystem::path& folder);
+
 // Reads only the header; throws Error naming the file when it is missing or not an image.
 ImageHeader read_image_header(const std::filesystem::path& path);
 // Decodes a PNG or JPEG keeping its channel count (1, 2, 3 or 4).

@@ -78,6 +78,21 @@ TEST(Image, ToEightBitRoundsAndClamps) {
   EXPECT_EQ(to_8bit(image).data, (std::vector<uint8_t>{0, 128, 255, 51}));
 }
 
+TEST(Image, FolderListingTakesItsImagesInNameOrder) {
+  TempDir dir;
+  for (const char* name : {"b.JPG", "a.png", "c.jpeg", "notes.txt", "depth.npy"})
+    write_text(dir / name, "");
+  std::filesystem::create_directory(dir / "sub.png");  // a folder, whatever its name
+  const std::vector<std::filesystem::path> images = image_files_in(dir.path());
+  ASSERT_EQ(images.size(), 3u);
+  EXPECT_EQ(images[0].filename(), "a.png");
+  EXPECT_EQ(images[1].filename(), "b.JPG");
+  EXPECT_EQ(images[2].filename(), "c.jpeg");
+  std::filesystem::create_directory(dir / "empty");
+  EXPECT_EQ(error_message([&] { image_files_in(dir / "empty"); }),
+            (dir / "empty").string() + ": no PNG or JPEG images in this folder");
+}
+
 TEST(Image, MissingFileIsNamed) {
   TempDir dir;
   const std::string message = error_message([&] { read_image8(dir / "nope.png"); });

@@ -1,11 +1,9 @@
 #include "priors/depth/depth_files.hpp"
 
-#include <algorithm>
 #include <set>
 #include <string>
 
 #include "core/error.hpp"
-#include "core/paths.hpp"
 #include "io/image.hpp"
 #include "io/npy.hpp"
 #include "priors/depth/depth_preview.hpp"
@@ -18,15 +16,6 @@ namespace fs = std::filesystem;
 
 fs::path preview_path(fs::path npy) {
   return npy.replace_filename(npy.stem().string() + "_preview.png");
-}
-
-std::vector<fs::path> images_in(const fs::path& folder) {
-  std::vector<fs::path> images;
-  for (const fs::directory_entry& entry : fs::directory_iterator(folder))
-    if (entry.is_regular_file() && is_image_file(entry.path())) images.push_back(entry.path());
-  if (images.empty()) fail_file(folder, "no PNG or JPEG images in this folder");
-  std::sort(images.begin(), images.end());
-  return images;
 }
 
 // Two images with one stem (a.png, a.jpg), or an output folder that is the input one, would
@@ -45,7 +34,7 @@ void check_names_unique(const std::vector<DepthJob>& jobs) {
 std::vector<DepthJob> plan_depth_jobs(const fs::path& in, const fs::path& out) {
   std::vector<DepthJob> jobs;
   if (fs::is_directory(in)) {
-    for (const fs::path& image : images_in(in)) {
+    for (const fs::path& image : image_files_in(in)) {
       const fs::path npy = out / image.filename().replace_extension(".npy");
       jobs.push_back({image, npy, preview_path(npy)});
     }
