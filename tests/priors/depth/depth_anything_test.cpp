@@ -8,14 +8,15 @@
 
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
-#include "io/npy.hpp"
 #include "support/expect_error.hpp"
 #include "support/module_shapes.hpp"
+#include "support/tensor_files.hpp"
 
 namespace iesrgs::priors::depth {
 namespace {
 
 using testing::error_message;
+using testing::max_abs_difference;
 using testing::parameter_shapes;
 using testing::ParameterShapes;
 using testing::read_parameter_shapes;
@@ -23,9 +24,7 @@ using testing::read_parameter_shapes;
 const std::filesystem::path kData = std::filesystem::path(IESRGS_TEST_DATA) / "priors" / "depth";
 
 torch::Tensor read_tensor(const std::string& name) {
-  NpyArray array = read_npy(kData / name);
-  const std::vector<int64_t> shape(array.shape.begin(), array.shape.end());
-  return torch::from_blob(array.data.data(), shape, torch::kFloat32).clone();
+  return testing::read_npy_tensor(kData / name);
 }
 
 torch::Tensor fixture_image() {
@@ -45,11 +44,6 @@ DepthAnythingConfig tiny_config() {
 DepthAnythingV2 tiny_model() {
   const std::filesystem::path file = kData / "tiny.pth";
   return load_depth_anything(tiny_config(), read_state_dict(file), file);
-}
-
-float max_abs_difference(const torch::Tensor& a, const torch::Tensor& b) {
-  EXPECT_EQ(a.sizes(), b.sizes());
-  return (a - b).abs().max().item<float>();
 }
 
 class DepthAnythingForward : public ::testing::TestWithParam<std::string> {};

@@ -10,12 +10,12 @@
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
-#include "io/npy.hpp"
 #include "io/resize.hpp"
 #include "priors/keras_model.hpp"
 #include "support/expect_error.hpp"
 #include "support/scoped_env.hpp"
 #include "support/temp_dir.hpp"
+#include "support/tensor_files.hpp"
 
 namespace iesrgs::priors::sr {
 namespace {
@@ -23,6 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 using iesrgs::testing::error_message;
+using iesrgs::testing::max_abs_difference;
 using iesrgs::testing::ScopedEnv;
 using iesrgs::testing::TempDir;
 using iesrgs::testing::write_text;
@@ -31,20 +32,13 @@ const fs::path kEsrganFixtures = fs::path(IESRGS_TEST_DATA) / "priors" / "esrgan
 
 // An NHWC array written by make_fixtures.js, as an NCHW tensor.
 torch::Tensor read_nchw(const fs::path& file) {
-  NpyArray array = read_npy(file);
-  const std::vector<int64_t> shape(array.shape.begin(), array.shape.end());
-  return torch::from_blob(array.data.data(), shape).permute({0, 3, 1, 2}).clone();
-}
-
-double max_difference(const torch::Tensor& a, const torch::Tensor& b) {
-  EXPECT_EQ(a.sizes(), b.sizes());
-  return (a - b).abs().max().item<double>();
+  return iesrgs::testing::read_npy_tensor(file).permute({0, 3, 1, 2}).contiguous();
 }
 
 TEST(KerasModel, MatchesTensorFlowJs) {
   const auto model = keras::LayersModel::load(kEsrganFixtures / "tiny" / "model.json");
   const torch::Tensor output = model.forward(read_nchw(kEsrganFixtures / "tiny_input.npy"));
-  EXPECT_LT(max_difference(output, read_nchw(kEsrganFixtures / "tiny_output.npy")), 1e-5);
+  EXPECT_LT(max_abs_difference(output, read_nchw(kEsrganFixtures / "tiny_output.npy")), 1e-5);
 }
 
 // A copy of the tiny model whose model.json `edit` changed, and the error loading it gives.
@@ -124,7 +118,7 @@ TEST(Esrgan, SlimX4MatchesTensorFlowJs) {
   const torch::Tensor input = read_nchw(kEsrganFixtures / "slim_x4_input.npy") / 255;
   const torch::Tensor expected =
       (read_nchw(kEsrganFixtures / "slim_x4_output.npy") / 255).clamp(0, 1);
-  EXPECT_LT(max_difference(net->upscale(input), expected), 1e-4);
+  EXPECT_LT(max_abs_difference(net->upscale(input), expected), 1e-4);
 }
 
 TEST(Esrgan, RejectsUnknownVariantsScalesAndMissingPackages) {

@@ -11,10 +11,10 @@
 
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
-#include "io/npy.hpp"
 #include "io/resize.hpp"
 #include "priors/sr/sr_net.hpp"
 #include "priors/state_dict.hpp"
+#include "support/tensor_files.hpp"
 
 namespace iesrgs::priors::sr::sr_testing {
 
@@ -23,21 +23,12 @@ inline const std::filesystem::path kFixtures =
 inline const std::filesystem::path kReleasedWeights =
     std::filesystem::path(IESRGS_SHARED_DATA) / "weights" / "sr";
 
-inline torch::Tensor read_npy_tensor(const std::filesystem::path& path) {
-  NpyArray array = read_npy(path);
-  const std::vector<int64_t> shape(array.shape.begin(), array.shape.end());
-  return torch::tensor(array.data).view(shape);
-}
+using testing::max_abs_difference;
+using testing::read_npy_tensor;
 
 // (1, 3, 20, 24): a crop of lego test view 0 after the protocol's bicubic x1/4, over white.
 inline torch::Tensor lego_crop() {
   return read_npy_tensor(kFixtures / "lego_lr_crop.npy");
-}
-
-// The largest absolute difference, or infinity when the shapes differ.
-inline float max_abs_difference(const torch::Tensor& a, const torch::Tensor& b) {
-  if (a.sizes() != b.sizes()) return INFINITY;
-  return (a - b).abs().max().item<float>();
 }
 
 inline int64_t parameter_count(torch::nn::Module& module) {
