@@ -9,6 +9,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
+#include "core/math.hpp"
 #include "io/atomic_file.hpp"
 #include "io/model_file.hpp"
 #include "io/scene.hpp"
@@ -35,7 +36,7 @@ void print_summary(const Scene& scene) {
                scene.downscale > 1 ? fmt::format(", downscaled by {}", scene.downscale) : "");
   const Intrinsics& k = scene.cameras.front().intrinsics;
   fmt::print("intrinsics  fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f} (fov {:.2f} x {:.2f} deg)\n",
-             k.fx, k.fy, k.cx, k.cy, k.fov_x() * 57.29577951308232, k.fov_y() * 57.29577951308232);
+             k.fx, k.fy, k.cx, k.cy, k.fov_x() * 180 / kPi, k.fov_y() * 180 / kPi);
   if (distorted)
     fmt::print("distortion  {} cameras, undistorted to pinhole when loaded\n", distorted);
   fmt::print("points      {}\n", scene.points.positions.size());

@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   });
   // Which device --device auto takes here, so a user sees at once whether the GPU is usable.
   app.set_version_flag("--version", [] {
-    return fmt::format("iesrgs 0.1.0\nCUDA kernels: {}\n--device auto: {}",
+    return fmt::format("iesrgs " IESRGS_VERSION "\nCUDA kernels: {}\n--device auto: {}",
                        iesrgs::cuda_kernels_built() ? "built" : "not built",
                        iesrgs::describe_device(iesrgs::parse_device("auto")));
   });

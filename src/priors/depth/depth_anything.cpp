@@ -10,14 +10,12 @@ namespace iesrgs::priors::depth {
 
 namespace {
 
-constexpr int kSideMultiple = 14;
-
 // numpy's round, as the authors' constrain_to_multiple_of uses: halves go to the even neighbour,
 // which std::nearbyint does in the default rounding mode.
 int64_t multiple_at_least(double side, int minimum) {
-  const double steps = side / kSideMultiple;
-  const int64_t rounded = int64_t(std::nearbyint(steps)) * kSideMultiple;
-  return rounded >= minimum ? rounded : int64_t(std::ceil(steps)) * kSideMultiple;
+  const double steps = side / kDinoPatchSize;
+  const int64_t rounded = int64_t(std::nearbyint(steps)) * kDinoPatchSize;
+  return rounded >= minimum ? rounded : int64_t(std::ceil(steps)) * kDinoPatchSize;
 }
 
 torch::Tensor channel_constants(const std::array<double, 3>& values,

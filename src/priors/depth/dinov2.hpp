@@ -8,12 +8,15 @@
 
 namespace iesrgs::priors::depth {
 
+// DINOv2's patches are 14 pixels wide; the authors' DPT head and input sizes assume it.
+constexpr int kDinoPatchSize = 14;
+
 struct VitConfig {
   int embed_dim = 384;
   int depth = 12;
   int num_heads = 6;
   int mlp_ratio = 4;
-  int patch_size = 14;
+  int patch_size = kDinoPatchSize;
   // Side of the square patch grid the positional embedding was trained on (518 / 14).
   int pos_grid = 37;
 };

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "priors/depth/dinov2.hpp"
+
 namespace iesrgs::priors::depth {
 
 namespace {
@@ -10,7 +12,6 @@ using torch::nn::Conv2d;
 using torch::nn::Conv2dOptions;
 
 constexpr int kHiddenChannels = 32;  // fixed in the authors' output convolutions
-constexpr int64_t kPatchSize = 14;   // the authors' head assumes DINOv2's 14-pixel patches
 
 Conv2d conv3x3(int in, int out, bool bias = true) {
   return Conv2d(Conv2dOptions(in, out, 3).padding(1).bias(bias));
@@ -114,7 +115,7 @@ torch::Tensor DptHeadImpl::forward(const std::vector<torch::Tensor>& tokens, int
   std::array<torch::Tensor, 4> levels;
   for (size_t level = 0; level < 4; ++level)
     levels[level] = reassemble(level, tokens[level], patch_h, patch_w);
-  return predict(fuse(levels), kPatchSize * patch_h, kPatchSize * patch_w);
+  return predict(fuse(levels), kDinoPatchSize * patch_h, kDinoPatchSize * patch_w);
 }
 
 }  // namespace iesrgs::priors::depth
