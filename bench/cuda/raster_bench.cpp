@@ -5,7 +5,6 @@
 #include <fmt/format.h>
 #include <omp.h>
 
-#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -14,6 +13,7 @@
 #include "core/cuda/device.hpp"
 #include "core/cuda/device_array.hpp"
 #include "core/error.hpp"
+#include "core/stopwatch.hpp"
 #include "gs/sh.hpp"
 #include "loss/cuda/ssim.hpp"
 #include "loss/ssim.hpp"
@@ -61,12 +61,6 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
 // Gradient floats per Gaussian: GaussianGrads' arrays laid end to end.
 constexpr size_t kGradFloats = 3 + 3 + 4 + 1 + 3 + gs::kShRestFloats + 2 + 2;
 
@@ -105,9 +99,9 @@ struct CudaFrame {
 template <typename F>
 double time_frames(int frames, F&& f) {
   for (int i = 0; i < 2; ++i) f();
-  const auto start = Clock::now();
+  const Stopwatch watch;
   for (int i = 0; i < frames; ++i) f();
-  return ms_since(start) / frames;
+  return watch.milliseconds() / frames;
 }
 
 void bench_cpu(const GaussianCloud& cloud, const RasterCamera<float>& cam, int frames) {

@@ -7,7 +7,6 @@
 #include <torch/torch.h>
 
 #include <algorithm>
-#include <chrono>
 #include <ctime>
 #include <functional>
 #include <vector>
@@ -17,6 +16,7 @@
 #include "core/cpu_isa.hpp"
 #include "core/math.hpp"
 #include "core/memory.hpp"
+#include "core/stopwatch.hpp"
 #include "gs/benchmark_model.hpp"
 #include "gs/model.hpp"
 #include "gs/optimizer.hpp"
@@ -60,12 +60,6 @@ struct AdamBenchArgs {
   RepeatArgs repeat{0, 20};
 };
 
-using Clock = std::chrono::steady_clock;
-
-double elapsed_ms(Clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
-}
-
 struct Timing {
   double wall_ms = 0;  // median
   double cpu_ms = 0;   // mean, summed over threads
@@ -87,9 +81,9 @@ Timing time_runs(int iterations, const std::function<void(int)>& work) {
   std::clock_t cpu_start = 0;
   for (int it = -1; it < iterations; ++it) {
     if (it == 0) cpu_start = std::clock();
-    const auto start = Clock::now();
+    const Stopwatch watch;
     work(it);
-    if (it >= 0) wall.push_back(elapsed_ms(start));
+    if (it >= 0) wall.push_back(watch.milliseconds());
   }
   return {median(wall), 1000.0 * double(std::clock() - cpu_start) / CLOCKS_PER_SEC / iterations};
 }
@@ -177,10 +171,10 @@ void run_raster_bench(const RasterBenchArgs& args) {
   const float background[3] = {1, 1, 1};
   RasterFrame<float> frame;
   const auto render_frame = [&](const RasterCamera<float>& cam) {
-    const auto start = Clock::now();
+    const Stopwatch watch;
     rasterize_forward(g, cam, background, frame,
                       RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
-    const double forward_ms = elapsed_ms(start);
+    const double forward_ms = watch.milliseconds();
     rasterize_backward(
         g, frame, PixelGrads<float>{dimage.data(), dalpha.data(), ddepth.data()},
         GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(), dlogits.data(),

@@ -1,12 +1,12 @@
 // iesrgs synth: the built-in synthetic scene, written as a NeRF-Synthetic dataset.
 #include <fmt/format.h>
 
-#include <chrono>
 #include <map>
 #include <memory>
 #include <string>
 
 #include "cli/commands.hpp"
+#include "core/stopwatch.hpp"
 #include "synth/dataset_writer.hpp"
 
 namespace iesrgs::cli {
@@ -42,19 +42,18 @@ void add_synth_command(CLI::App& app) {
       ->transform(CLI::CheckedTransformer(formats, CLI::ignore_case))
       ->default_str("blender");
   command->callback([output, options] {
-    const auto start = std::chrono::steady_clock::now();
+    const Stopwatch watch;
     synth::write_synth_dataset(*output, *options, [](int done, int total) {
       fmt::print(stderr, "\rrendered {}/{} views", done, total);
       if (done == total) fmt::print(stderr, "\n");
     });
-    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
     const std::string views =
         options->format == synth::SynthFormat::Colmap
             ? fmt::format("{} views (every 8th is held out for test)",
                           options->train_views + options->test_views)
             : fmt::format("{} train and {} test views", options->train_views, options->test_views);
     fmt::print("wrote {} of {}x{} to {} in {:.1f} s\n", views, options->size, options->size,
-               *output, elapsed.count());
+               *output, watch.seconds());
   });
 }
 

@@ -3,11 +3,11 @@
 #include <fmt/core.h>
 #include <torch/torch.h>
 
-#include <chrono>
 #include <nlohmann/json.hpp>
 
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "core/stopwatch.hpp"
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
 #include "io/image.hpp"
@@ -97,7 +97,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
   const std::vector<const Camera*> cameras = scene.split(Split::Train);
   std::vector<ExternalView> views;
   size_t computed = 0;
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch watch;
   for (size_t i = 0; i < cameras.size(); ++i) {
     const Camera& camera = *cameras[i];
     const ExternalView view = external_view(camera, options, dir);
@@ -126,8 +126,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
     record[camera.name] = fingerprint;
     write_file_atomically(record_path, record.dump(1) + "\n");
     ++computed;
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = watch.seconds();
     // The views left may be cached: the estimate errs long.
     fmt::print("external {}/{} {}: {:.2f} s per view, ETA {}\n", i + 1, cameras.size(), camera.name,
                seconds / double(computed),

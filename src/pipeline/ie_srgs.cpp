@@ -4,12 +4,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <chrono>
 #include <functional>
 #include <memory>
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/stopwatch.hpp"
 #include "eval/mask_agreement.hpp"
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
@@ -35,18 +35,13 @@ namespace {
 namespace fs = std::filesystem;
 using loss::TextureGuidance;
 
-double elapsed_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 // The HR rows take nearly all of a run's time: after each, where the run stands, with an ETA for
 // the rows left to train at the pace of those trained so far (a row reused from the cache takes
 // seconds, and is counted in neither).
 class HrRowProgress {
  public:
   // Whether each HR row, in order, has to train: its stage is not cached.
-  explicit HrRowProgress(std::vector<bool> trains)
-      : trains_(std::move(trains)), start_(std::chrono::steady_clock::now()) {}
+  explicit HrRowProgress(std::vector<bool> trains) : trains_(std::move(trains)) {}
 
   void row_done(double seconds) {
     if (trains_[done_++]) {
@@ -57,7 +52,7 @@ class HrRowProgress {
     const auto left =
         size_t(std::count(trains_.begin() + std::ptrdiff_t(done_), trains_.end(), true));
     fmt::print("HR rows: {} of {} done in {}{}\n", done_, trains_.size(),
-               train::format_duration(elapsed_since(start_)),
+               train::format_duration(watch_.seconds()),
                trained_ && left
                    ? fmt::format(", ETA {} for the rest",
                                  train::format_eta(trained_, trained_ + left, trained_seconds_))
@@ -68,7 +63,7 @@ class HrRowProgress {
   std::vector<bool> trains_;
   size_t done_ = 0, trained_ = 0;
   double trained_seconds_ = 0;
-  std::chrono::steady_clock::time_point start_;
+  Stopwatch watch_;
 };
 
 class Pipeline {
@@ -213,7 +208,7 @@ void Pipeline::check_cached_inputs() const {
 }
 
 void Pipeline::run_external_stages() {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch watch;
   ExternalOptions options = o_.external;
   if (any_row(Source::SuperResolved))
     external_ = run_external_stage(lr_scene_, *lr_images_, options, o_.output / "external");
@@ -223,7 +218,7 @@ void Pipeline::run_external_stages() {
     options.depth_model = "none";
     bicubic_ = run_external_stage(lr_scene_, *lr_images_, options, o_.output / "bicubic");
   }
-  stages_["external_seconds"] = elapsed_since(start);
+  stages_["external_seconds"] = watch.seconds();
 }
 
 void Pipeline::run_internal_stage() {
@@ -347,10 +342,10 @@ gs::GaussianModel Pipeline::initial_hr_model() const {
 
 RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& model,
                                  const fs::path& dir) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch watch;
   const Evaluation evaluation = render_and_evaluate(model, test_cameras(), lr_scene_.background,
                                                     hr_images_.get(), o_.lpips, dir / "test");
-  stages_["evaluation_seconds"][row.id] = elapsed_since(start);
+  stages_["evaluation_seconds"][row.id] = watch.seconds();
   RowResult result;
   result.id = row.id;
   result.label = row_label(row);
@@ -454,7 +449,7 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
 }
 
 RunResult Pipeline::run() {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch watch;
   if (o_.only == StageSelection::Fusion) check_cached_inputs();
   if (o_.only != StageSelection::Internal) run_external_stages();
   if (rows_use_internal_references() || o_.only == StageSelection::Internal) run_internal_stage();
@@ -470,9 +465,9 @@ RunResult Pipeline::run() {
     const RowSpec& row = row_spec(rows_[i]);
     fmt::print("\n== row {}/{} {}: {} ==\n", i + 1, rows_.size(), row.id, row_label(row));
     if (row.source != Source::Internal) {
-      const auto row_start = std::chrono::steady_clock::now();
+      const Stopwatch row_watch;
       result.rows.push_back(run_fusion_row(row));
-      progress.row_done(elapsed_since(row_start));
+      progress.row_done(row_watch.seconds());
       continue;
     }
     RowResult internal = evaluate_row(row, internal_->training.model, o_.output / "rows" / row.id);
@@ -482,7 +477,7 @@ RunResult Pipeline::run() {
   result.evaluation = {{"test_views", test_digest_},
                        {"lpips", lpips_status_.empty() ? o_.lpips : lpips_status_}};
   keep_earlier_rows(result);
-  stages_["total_seconds_this_run"] = elapsed_since(start);
+  stages_["total_seconds_this_run"] = watch.seconds();
   result.stages = stages_;
   return result;
 }

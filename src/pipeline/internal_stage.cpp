@@ -2,8 +2,7 @@
 
 #include <fmt/core.h>
 
-#include <chrono>
-
+#include "core/stopwatch.hpp"
 #include "pipeline/render_views.hpp"
 #include "pipeline/stage_record.hpp"
 #include "train/session.hpp"
@@ -61,10 +60,9 @@ InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train
       renders_present(stage.sr_dir, lr_scene, scale))
     return stage;
   fmt::print("SR-splatting: rendering {} training views at x{}\n", cameras.size(), scale);
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch watch;
   render_views_to(stage.sr_dir, stage.training.model, cameras, lr_scene.background, scale);
-  stage.sr_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stage.sr_seconds = watch.seconds();
   record_stage(stage.sr_dir, sr, true, stage.sr_seconds);
   return stage;
 }

@@ -3,9 +3,9 @@
 #include <fmt/core.h>
 #include <torch/torch.h>
 
-#include <chrono>
 #include <cmath>
 
+#include "core/stopwatch.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "io/npy.hpp"
@@ -69,10 +69,9 @@ double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel
   double render_seconds = 0;
   for (size_t i = 0; i < cameras.size(); ++i) {
     const Camera camera = cameras[i].scaled(scale);
-    const auto start = std::chrono::steady_clock::now();
+    const Stopwatch watch;
     const RenderedView view = render_view(model, camera, background);
-    render_seconds +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    render_seconds += watch.seconds();
     write_rendered_view(dir, camera.name, view);
     if ((i + 1) % 20 == 0 || i + 1 == cameras.size())
       fmt::print("rendered {}/{} views at {}x{}\n", i + 1, cameras.size(), camera.intrinsics.width,

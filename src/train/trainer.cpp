@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <fstream>
@@ -309,8 +308,7 @@ void Trainer::fail_diverged(int64_t iteration, double loss) const {
 }
 
 double Trainer::training_seconds() const {
-  return seconds_before_ +
-         std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start_).count();
+  return seconds_before_ + run_watch_.seconds();
 }
 
 double Trainer::evaluate_psnr(const std::vector<TrainView>& views) const {
@@ -339,7 +337,7 @@ TrainSummary Trainer::run() {
   ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations,
                   config_.log_every, seconds_before_);
   write_cameras_json(cameras_path(), train_cameras_);
-  run_start_ = std::chrono::steady_clock::now();
+  run_watch_.restart();
   while (iteration_ < config_.iterations) {
     last_loss_ = step(iteration_ + 1);
     ++iteration_;

@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -15,6 +14,7 @@
 #include <vector>
 
 #include "core/device.hpp"
+#include "core/stopwatch.hpp"
 #include "gs/model.hpp"
 #include "io/camera.hpp"
 #include "raster/autograd.hpp"
@@ -119,7 +119,7 @@ class Trainer {
   double last_loss_ = 0;
   std::optional<double> last_test_psnr_;
   bool memory_capped_ = false;  // densification was held back for memory (warned once)
-  std::chrono::steady_clock::time_point run_start_ = std::chrono::steady_clock::now();
+  Stopwatch run_watch_;         // this process's training time
 };
 
 }  // namespace iesrgs::train
