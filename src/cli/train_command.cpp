@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
+
 #include "cli/commands.hpp"
 #include "cli/device_option.hpp"
 #include "cli/scene_options.hpp"
@@ -32,12 +34,16 @@ struct TrainArgs {
   std::string init_ply;
   bool resume = false;
   bool run_options_given = false;  // any of those that make up the config
+  bool schedule_given = false;     // --preset or --iterations
   std::string device = "auto";
 };
 
-// The config a new run with these options trains with.
-train::TrainConfig requested_config(const TrainArgs& args) {
-  train::TrainConfig config = train::make_preset(args.preset, args.iterations);
+// The config a new run with these options trains with, starting from `base` when no schedule
+// is given.
+train::TrainConfig requested_config(const TrainArgs& args,
+                                    const std::optional<train::TrainConfig>& base = std::nullopt) {
+  train::TrainConfig config =
+      base && !args.schedule_given ? *base : train::make_preset(args.preset, args.iterations);
   if (!args.config_file.empty())
     train::apply_json(config, read_json_file(args.config_file), args.config_file);
   if (args.views_per_iteration > 0) config.views_per_iteration = args.views_per_iteration;
@@ -49,7 +55,8 @@ train::TrainConfig requested_config(const TrainArgs& args) {
 }
 
 // The stored config is the run's identity: --resume continues with it. Options given beside it
-// must make the same config (the run's own command again), or none be given.
+// must make the same config (the run's own command again), or none be given. Without a schedule
+// they apply to the stored config, so that the refusal names only what they change.
 train::TrainConfig resumed_config(const TrainArgs& args, const std::filesystem::path& saved) {
   if (!std::filesystem::exists(saved))
     fail_file(saved, "missing: --resume needs the output folder of an earlier run");
@@ -58,7 +65,7 @@ train::TrainConfig resumed_config(const TrainArgs& args, const std::filesystem::
   spdlog::info("resuming with the config saved in {}", saved.string());
   if (!args.run_options_given) return config;
   const nlohmann::json kept = train::to_json(config),
-                       asked = train::to_json(requested_config(args));
+                       asked = train::to_json(requested_config(args, config));
   std::vector<std::string> changes;
   for (const auto& item : kept.items())
     if (asked[item.key()] != item.value())
@@ -136,12 +143,12 @@ void add_train_command(CLI::App& app) {
     run_options.push_back(option);
     return option;
   };
-  defines_run(command->add_option("--preset", args->preset,
-                                  "Schedule: paper (30k, GPU), cpu (10k), fast (3k)"))
-      ->capture_default_str();
-  defines_run(command->add_option("--iterations", args->iterations,
-                                  "Iterations; the preset's schedule is rescaled to fit"))
-      ->check(kPositive);
+  CLI::Option* preset = defines_run(command->add_option(
+      "--preset", args->preset, "Schedule: paper (30k, GPU), cpu (10k), fast (3k)"));
+  preset->capture_default_str();
+  CLI::Option* iterations = defines_run(command->add_option(
+      "--iterations", args->iterations, "Iterations; the preset's schedule is rescaled to fit"));
+  iterations->check(kPositive);
   defines_run(command->add_option("--mv", args->views_per_iteration,
                                   "Views per iteration (multi-view regulation K; 1 = plain 3DGS)"))
       ->check(kPositive);
@@ -157,8 +164,9 @@ void add_train_command(CLI::App& app) {
   command->add_flag("--resume", args->resume,
                     "Continue the run in --output from its checkpoint, with its saved config");
   add_device_option(*command, args->device);
-  command->callback([args, run_options] {
+  command->callback([args, run_options, preset, iterations] {
     for (const CLI::Option* option : run_options) args->run_options_given |= option->count() > 0;
+    args->schedule_given = preset->count() > 0 || iterations->count() > 0;
     run_train(*args);
   });
 }

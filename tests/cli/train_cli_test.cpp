@@ -187,6 +187,13 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   EXPECT_TRUE(contains(last_line(longer.output), "would change it (") &&
               contains(last_line(longer.output), "iterations 20 instead of 10"))
       << longer.output;
+  // Without a schedule, the options given are compared on top of the run's own.
+  const CliRun reseeded = iesrgs(train + " --resume --seed 5");
+  EXPECT_EQ(reseeded.status, 1);
+  EXPECT_TRUE(contains(last_line(reseeded.output), "would change it (seed 5 instead of 0);"))
+      << reseeded.output;
+  const CliRun repeated = iesrgs(train + " --resume --set random_points=500");
+  EXPECT_EQ(repeated.status, 0) << repeated.output;
   const CliRun halved = iesrgs(train + " --resume --downscale 2");
   EXPECT_EQ(halved.status, 1);
   EXPECT_TRUE(contains(last_line(halved.output), "cameras.json: the run trained on other cameras"))
