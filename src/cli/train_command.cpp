@@ -34,16 +34,18 @@ struct TrainArgs {
   std::string init_ply;
   bool resume = false;
   bool run_options_given = false;  // any of those that make up the config
-  bool schedule_given = false;     // --preset or --iterations
+  bool preset_given = false;
   std::string device = "auto";
 };
 
-// The config a new run with these options trains with, starting from `base` when no schedule
-// is given.
+// The config a new run with these options trains with. With `base` and no --preset, the options
+// apply to `base` instead, --iterations rescaling its schedule.
 train::TrainConfig requested_config(const TrainArgs& args,
                                     const std::optional<train::TrainConfig>& base = std::nullopt) {
   train::TrainConfig config =
-      base && !args.schedule_given ? *base : train::make_preset(args.preset, args.iterations);
+      base && !args.preset_given ? *base : train::make_preset(args.preset, args.iterations);
+  if (base && !args.preset_given && args.iterations > 0)
+    train::rescale_schedule(config, args.iterations);
   if (!args.config_file.empty())
     train::apply_json(config, read_json_file(args.config_file), args.config_file);
   if (args.views_per_iteration > 0) config.views_per_iteration = args.views_per_iteration;
@@ -55,7 +57,7 @@ train::TrainConfig requested_config(const TrainArgs& args,
 }
 
 // The stored config is the run's identity: --resume continues with it. Options given beside it
-// must make the same config (the run's own command again), or none be given. Without a schedule
+// must make the same config (the run's own command again), or none be given. Without --preset
 // they apply to the stored config, so that the refusal names only what they change.
 train::TrainConfig resumed_config(const TrainArgs& args, const std::filesystem::path& saved) {
   if (!std::filesystem::exists(saved))
@@ -146,9 +148,9 @@ void add_train_command(CLI::App& app) {
   CLI::Option* preset = defines_run(command->add_option(
       "--preset", args->preset, "Schedule: paper (30k, GPU), cpu (10k), fast (3k)"));
   preset->capture_default_str();
-  CLI::Option* iterations = defines_run(command->add_option(
-      "--iterations", args->iterations, "Iterations; the preset's schedule is rescaled to fit"));
-  iterations->check(kPositive);
+  defines_run(command->add_option("--iterations", args->iterations,
+                                  "Iterations; the preset's schedule is rescaled to fit"))
+      ->check(kPositive);
   defines_run(command->add_option("--mv", args->views_per_iteration,
                                   "Views per iteration (multi-view regulation K; 1 = plain 3DGS)"))
       ->check(kPositive);
@@ -164,9 +166,9 @@ void add_train_command(CLI::App& app) {
   command->add_flag("--resume", args->resume,
                     "Continue the run in --output from its checkpoint, with its saved config");
   add_device_option(*command, args->device);
-  command->callback([args, run_options, preset, iterations] {
+  command->callback([args, run_options, preset] {
     for (const CLI::Option* option : run_options) args->run_options_given |= option->count() > 0;
-    args->schedule_given = preset->count() > 0 || iterations->count() > 0;
+    args->preset_given = preset->count() > 0;
     run_train(*args);
   });
 }

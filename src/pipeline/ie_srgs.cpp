@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/stopwatch.hpp"
+#include "eval/lpips.hpp"
 #include "eval/mask_agreement.hpp"
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
@@ -86,6 +87,7 @@ class Pipeline {
   FusionSetup fusion_setup(const RowSpec& row, const loss::FusionWeights& weights) const;
   nlohmann::json row_params(const RowSpec& row, const loss::FusionWeights& weights) const;
   gs::GaussianModel initial_hr_model() const;
+  void warn_if_lpips_unavailable() const;
   RowResult evaluate_row(const RowSpec& row, const gs::GaussianModel& model, const fs::path& dir);
   RowResult run_fusion_row(const RowSpec& row);
   // Whether the earlier table's `entry` for `row` is what these settings would give.
@@ -163,6 +165,15 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
         "(--input-is-lr) lacks");
   train_digest_ = split_digest(*lr_images_, Split::Train);
   test_digest_ = split_digest(hr_images_ ? *hr_images_ : *lr_images_, Split::Test);
+  warn_if_lpips_unavailable();
+}
+
+// Before the trainings, not after the first of them: the table will show "-" for LPIPS.
+void Pipeline::warn_if_lpips_unavailable() const {
+  if (!hr_images_ || o_.lpips == "none") return;
+  const eval::LpipsNet net = eval::parse_lpips_net(o_.lpips);
+  if (const auto missing = eval::lpips_unavailable_reason(net, eval::default_lpips_weights(net)))
+    spdlog::warn("LPIPS ({}) unavailable: {}", o_.lpips, *missing);
 }
 
 bool Pipeline::any_row(const std::function<bool(const RowSpec&)>& test) const {
@@ -352,9 +363,6 @@ RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& mo
   result.evaluated = !evaluation.report.views.empty();
   if (result.evaluated) {
     result.mean = evaluation.report.mean();
-    // The table shows "-" for a missing LPIPS: say once why.
-    if (lpips_status_.empty() && evaluation.report.lpips_status.rfind("unavailable", 0) == 0)
-      spdlog::warn("LPIPS ({}) {}", o_.lpips, evaluation.report.lpips_status);
     lpips_status_ = evaluation.report.lpips_status;
   }
   result.fps = evaluation.seconds_per_view > 0 ? 1 / evaluation.seconds_per_view : 0;
@@ -474,8 +482,10 @@ RunResult Pipeline::run() {
     internal.train_seconds = internal_->training.seconds;
     result.rows.push_back(internal);
   }
-  result.evaluation = {{"test_views", test_digest_},
-                       {"lpips", lpips_status_.empty() ? o_.lpips : lpips_status_}};
+  // "lpips" is the net asked for, which earlier rows are matched by; the status says whether it
+  // was computed.
+  result.evaluation = {{"test_views", test_digest_}, {"lpips", o_.lpips}};
+  if (!lpips_status_.empty()) result.evaluation["lpips_status"] = lpips_status_;
   keep_earlier_rows(result);
   stages_["total_seconds_this_run"] = watch.seconds();
   result.stages = stages_;

@@ -192,8 +192,13 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   EXPECT_EQ(reseeded.status, 1);
   EXPECT_TRUE(contains(last_line(reseeded.output), "would change it (seed 5 instead of 0);"))
       << reseeded.output;
-  const CliRun repeated = iesrgs(train + " --resume --set random_points=500");
+  const CliRun repeated = iesrgs(train + " --resume --set random_points=500 --iterations 10");
   EXPECT_EQ(repeated.status, 0) << repeated.output;
+  const CliRun doubled = iesrgs(train + " --resume --iterations 20");
+  EXPECT_EQ(doubled.status, 1);
+  EXPECT_TRUE(contains(last_line(doubled.output), "iterations 20 instead of 10") &&
+              !contains(last_line(doubled.output), "preset"))
+      << doubled.output;
   const CliRun halved = iesrgs(train + " --resume --downscale 2");
   EXPECT_EQ(halved.status, 1);
   EXPECT_TRUE(contains(last_line(halved.output), "cameras.json: the run trained on other cameras"))

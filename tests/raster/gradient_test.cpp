@@ -117,6 +117,27 @@ TEST(RasterBackward, MatchesFiniteDifferencesOnRandomScene) {
   check_every_group(cam, s, 5);
 }
 
+TEST(RasterBackward, OffCentrePrincipalPointMatchesFiniteDifferences) {
+  // The principal point 6 px left of the image, so that the clamp's bounds (x / z from 0.12 to
+  // 1.65) are far from symmetric; one Gaussian beyond each reaches into the image.
+  Camera cam = test_camera(24, 20);
+  cam.intrinsics.cx = -6;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Scene<double> s;
+  s.sh_degree = 1;
+  for (double x : {0.4, 0.7, 1.0, 1.3})
+    s.add(world_point(cam, x, 0.3 * u(rng), 3 + u(rng)), {-2.2, -2.5, -2.3}, random_quat(rng),
+          u(rng), {u(rng), u(rng), u(rng)}, 0.01, {0.1, -0.2, 0.1, 0.2, 0.1, -0.1, 0.3, 0.1, 0.2});
+  for (double x : {0.0, 1.8})
+    s.add(world_point(cam, x, 0.1, 3), {-0.5, -0.8, -0.6}, random_quat(rng), 0.5, {0.2, 0.4, -0.3},
+          0.01);
+  const KernelRender<double> r = kernel_render(s, cam, kGradientBackground);
+  EXPECT_GT(r.radii[4], 0);  // beyond the bounds, yet drawn
+  EXPECT_GT(r.radii[5], 0);
+  check_every_group(cam, s, 51);
+}
+
 TEST(RasterBackward, MatchesFiniteDifferencesAtEveryShDegree) {
   const Camera cam = test_camera(24, 20);
   for (int degree = 0; degree <= 3; ++degree) {
