@@ -26,7 +26,7 @@ void add_export_command(CLI::App& app);
 // for a folder whose training has not finished.
 inline std::filesystem::path model_file(const std::filesystem::path& path) {
   if (!std::filesystem::is_directory(path)) return path;
-  const std::filesystem::path model = path / "point_cloud.ply";
+  const std::filesystem::path model = train::model_path(path);
   if (!std::filesystem::exists(model) && std::filesystem::exists(train::checkpoint_path(path)))
     fail_file(path, std::string("its training has not finished (a checkpoint, no "
                                 "point_cloud.ply yet): ") +

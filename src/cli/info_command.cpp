@@ -94,8 +94,8 @@ void print_run_summary(const std::filesystem::path& run) {
     fmt::print("no results.md yet: the run has not finished\n");
   std::vector<std::filesystem::path> models;
   for (const auto& row : std::filesystem::directory_iterator(run / "rows"))
-    if (std::filesystem::exists(row.path() / "point_cloud.ply"))
-      models.push_back(row.path() / "point_cloud.ply");
+    if (std::filesystem::exists(train::model_path(row.path())))
+      models.push_back(train::model_path(row.path()));
   std::sort(models.begin(), models.end());
   for (const std::filesystem::path& model : models)
     fmt::print("model of {:<16} {}\n", model.parent_path().filename().string(), model.string());
@@ -136,7 +136,7 @@ void add_info_command(CLI::App& app) {
   command->callback([args, load_images] {
     const std::filesystem::path path = args->path;
     const bool training_folder =
-        !is_scene(path) && (std::filesystem::exists(path / "point_cloud.ply") ||
+        !is_scene(path) && (std::filesystem::exists(train::model_path(path)) ||
                             std::filesystem::exists(train::checkpoint_path(path)));
     if (is_model_file(path) || training_folder) {
       print_model_summary(model_file(path));

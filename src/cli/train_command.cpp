@@ -129,7 +129,7 @@ void run_train(const TrainArgs& args) {
              summary.iterations_per_second,
              summary.test_psnr ? fmt::format("test PSNR {:.2f} dB", *summary.test_psnr)
                                : std::string("no test views scored"),
-             (out / "point_cloud.ply").string());
+             train::model_path(out).string());
 }
 
 }  // namespace

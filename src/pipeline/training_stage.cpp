@@ -26,7 +26,7 @@ nlohmann::json stage_identity(const nlohmann::json& params, const train::TrainCo
 
 // A finished stage whose model was deleted (say, because it was damaged) trains again.
 bool model_finished(const fs::path& dir, const nlohmann::json& identity) {
-  return stage_finished(dir, identity) && fs::exists(dir / "point_cloud.ply");
+  return stage_finished(dir, identity) && fs::exists(train::model_path(dir));
 }
 
 }  // namespace
@@ -53,7 +53,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   const nlohmann::json identity = stage_identity(params, config);
   if (model_finished(dir, identity)) {
     try {
-      gs::GaussianModel model = gs::model_from_splat_cloud(read_ply(dir / "point_cloud.ply"));
+      gs::GaussianModel model = gs::model_from_splat_cloud(read_ply(train::model_path(dir)));
       fmt::print("{}: reusing the finished model in {}\n", name, dir.string());
       return {std::move(model), stage_seconds(dir), true};
     } catch (const Error& e) {

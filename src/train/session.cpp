@@ -84,14 +84,14 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
 
 void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianModel& model) {
   const SplatCloud cloud = gs::to_splat_cloud(model);
-  write_ply(dir / "point_cloud.ply", cloud);
+  write_ply(model_path(dir), cloud);
   write_ply_filter_baked(dir / "point_cloud_filter_baked.ply", cloud);
 }
 
 void remove_earlier_run(const std::filesystem::path& dir) {
   for (const std::filesystem::path& file :
        {checkpoint_path(dir), dir / "train_log.csv", dir / "cameras.json", dir / "training.json",
-        dir / "point_cloud.ply", dir / "point_cloud_filter_baked.ply"}) {
+        model_path(dir), dir / "point_cloud_filter_baked.ply"}) {
     std::error_code ec;
     std::filesystem::remove(file, ec);
     if (ec) fail_file(file, "cannot be removed before a new run: " + ec.message());

@@ -64,6 +64,11 @@ inline std::filesystem::path checkpoint_path(const std::filesystem::path& output
   return output_dir / "checkpoint.pt";
 }
 
+// The finished model in a training folder: the 3DGS point cloud viewers open.
+inline std::filesystem::path model_path(const std::filesystem::path& output_dir) {
+  return output_dir / "point_cloud.ply";
+}
+
 class Trainer {
  public:
   Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianModel initial);
