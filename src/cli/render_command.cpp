@@ -61,9 +61,9 @@ void remove_earlier_views(const std::filesystem::path& dir, const std::vector<st
     const std::string view = name.get<std::string>();
     if (!inside_folder(view) || std::find(names.begin(), names.end(), view) != names.end())
       continue;
+    const pipeline::RenderedViewFiles files = pipeline::rendered_view_files(dir, view);
     for (const std::filesystem::path& file :
-         {dir / "rgb" / (view + ".png"), dir / "depth" / (view + ".npy"),
-          dir / "depth" / (view + ".png"), dir / "alpha" / (view + ".png")}) {
+         {files.rgb, files.depth_npy, files.depth_png, files.alpha}) {
       std::error_code ec;
       if (!std::filesystem::remove(file, ec) && ec)
         fail_file(file, "an earlier render's view cannot be removed: " + ec.message());

@@ -26,7 +26,7 @@ Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector
   eval::MetricsReport& report = evaluation.report;
   const std::optional<eval::Lpips> metric = eval::load_default_lpips(lpips, report.lpips_status);
   for (const Camera& camera : cameras) {
-    const Image render = to_float(read_image8(dir / "rgb" / (camera.name + ".png")));
+    const Image render = to_float(read_image8(rendered_view_files(dir, camera.name).rgb));
     report.views.push_back(
         measure_view(camera.name, render, *truth->rgb(camera), metric ? &*metric : nullptr));
   }

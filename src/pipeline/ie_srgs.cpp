@@ -304,8 +304,9 @@ FusionSetup Pipeline::fusion_setup(const RowSpec& row, const loss::FusionWeights
     const std::string& name = setup.cameras[i].name;
     ReferenceFiles files{external[i].image, external[i].depth, {}, {}};
     if (internal_) {
-      files.internal_image = internal_->sr_dir / "rgb" / (name + ".png");
-      files.internal_depth = internal_->sr_dir / "depth" / (name + ".npy");
+      const RenderedViewFiles rendered = rendered_view_files(internal_->sr_dir, name);
+      files.internal_image = rendered.rgb;
+      files.internal_depth = rendered.depth_npy;
     }
     setup.targets.push_back(load_fusion_targets(files, setup.cameras[i], weights, threshold_));
     if (row.oracle_mask) setup.targets.back().internal_share = oracle_share(i, setup);

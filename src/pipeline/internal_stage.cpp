@@ -27,9 +27,8 @@ nlohmann::json sr_params(double model_seconds, int scale) {
 bool renders_present(const std::filesystem::path& sr_dir, const Scene& lr_scene, int scale) {
   for (const Camera* camera : lr_scene.split(Split::Train)) {
     const Intrinsics rendered = camera->intrinsics.scaled(scale);
-    if (!cached_view_intact(sr_dir / "rgb" / (camera->name + ".png"),
-                            sr_dir / "depth" / (camera->name + ".npy"), rendered.width,
-                            rendered.height))
+    const RenderedViewFiles files = rendered_view_files(sr_dir, camera->name);
+    if (!cached_view_intact(files.rgb, files.depth_npy, rendered.width, rendered.height))
       return false;
   }
   return true;

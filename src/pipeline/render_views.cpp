@@ -47,17 +47,23 @@ RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
   return view;
 }
 
+RenderedViewFiles rendered_view_files(const std::filesystem::path& dir, const std::string& name) {
+  return {dir / "rgb" / (name + ".png"), dir / "depth" / (name + ".npy"),
+          dir / "depth" / (name + ".png"), dir / "alpha" / (name + ".png")};
+}
+
 void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
                          const RenderedView& view) {
+  const RenderedViewFiles files = rendered_view_files(dir, name);
   const int height = int(view.depth.size(0)), width = int(view.depth.size(1));
-  write_png(dir / "rgb" / (name + ".png"), to_image8(view.image.unsqueeze(0)));
+  write_png(files.rgb, to_image8(view.image.unsqueeze(0)));
   const std::vector<float> depth = to_vector(view.depth);
-  write_npy(dir / "depth" / (name + ".npy"), depth, {size_t(height), size_t(width)});
+  write_npy(files.depth_npy, depth, {size_t(height), size_t(width)});
   std::vector<uint16_t> depth16(depth.size());
   for (size_t i = 0; i < depth.size(); ++i)
     depth16[i] = uint16_t(std::clamp(std::lround(depth[i] * kDepthPngScale), 0L, 65535L));
-  write_png16(dir / "depth" / (name + ".png"), depth16, width, height);
-  write_png(dir / "alpha" / (name + ".png"), gray_image8(view.alpha));
+  write_png16(files.depth_png, depth16, width, height);
+  write_png(files.alpha, gray_image8(view.alpha));
 }
 
 double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,

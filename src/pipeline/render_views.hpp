@@ -26,7 +26,13 @@ RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
 // Depth PNGs store millimetres-like units: value = depth * kDepthPngScale, clamped to 16 bits.
 constexpr double kDepthPngScale = 1000.0;
 
-// Writes <dir>/rgb/<name>.png, <dir>/depth/<name>.npy and .png, <dir>/alpha/<name>.png.
+// The files write_rendered_view makes for view `name` in `dir`: rgb/<name>.png, depth/<name>.npy
+// and .png, alpha/<name>.png.
+struct RenderedViewFiles {
+  std::filesystem::path rgb, depth_npy, depth_png, alpha;
+};
+RenderedViewFiles rendered_view_files(const std::filesystem::path& dir, const std::string& name);
+
 void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
                          const RenderedView& view);
 
