@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
-#include "priors/sr/registry.hpp"
+#include "priors/state_dict.hpp"
 
 namespace iesrgs::eval {
 namespace {
@@ -144,8 +144,8 @@ LpipsWeights default_lpips_weights(LpipsNet net) {
   fs::path backbone = torch_home() / "hub" / "checkpoints" / net_spec.backbone_file;
   if (auto dir = env_path("IESRGS_WEIGHTS_DIR"); dir && is_file(*dir / net_spec.backbone_file))
     backbone = *dir / net_spec.backbone_file;
-  return {backbone, priors::sr::default_weights_dir() / "lpips" / "v0.1" /
-                        (std::string(net_spec.name) + ".pth")};
+  return {backbone,
+          priors::default_weights_dir() / "lpips" / "v0.1" / (std::string(net_spec.name) + ".pth")};
 }
 
 std::optional<std::string> lpips_unavailable_reason(LpipsNet net, const LpipsWeights& weights) {

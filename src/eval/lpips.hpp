@@ -28,7 +28,7 @@ struct LpipsWeights {
 // file exists, else torchvision's download cache $TORCH_HOME/hub/checkpoints/<file> ($TORCH_HOME
 // defaults to $XDG_CACHE_HOME/torch, else ~/.cache/torch), with torchvision's file names
 // alexnet-owt-7be5be79.pth and vgg16-397923af.pth. Heads: lpips/v0.1/<net>.pth in the weights
-// folder the SR checkpoints come from (priors::sr::default_weights_dir).
+// folder the SR checkpoints come from (priors::default_weights_dir).
 LpipsWeights default_lpips_weights(LpipsNet net);
 
 // "<path>: no such file (<what it is>)" for the first missing file, nullopt when both exist.

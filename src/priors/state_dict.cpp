@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <string_view>
 
@@ -13,6 +14,11 @@
 #include "priors/pickle.hpp"
 
 namespace iesrgs::priors {
+
+std::filesystem::path default_weights_dir() {
+  if (const char* dir = std::getenv("IESRGS_WEIGHTS_DIR"); dir && *dir) return dir;
+  return IESRGS_DEV_WEIGHTS_DIR;
+}
 
 namespace {
 

@@ -11,6 +11,10 @@
 
 namespace iesrgs::priors {
 
+// The root of the checkpoint folders: $IESRGS_WEIGHTS_DIR when set, else the development data
+// beside the source tree (../shared/data/weights), which may not exist on a user's machine.
+std::filesystem::path default_weights_dir();
+
 // Parameter name -> tensor (contiguous, CPU), sorted by name. Floating-point tensors of any
 // precision become float32; integer buffers (BatchNorm's num_batches_tracked) keep their type,
 // so a strict load into a module that has them still finds them.

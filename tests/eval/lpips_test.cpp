@@ -209,7 +209,7 @@ TEST(Lpips, DefaultWeightsFollowTheWeightsDirectoryThenTorchsCache) {
   const LpipsWeights alex = default_lpips_weights(LpipsNet::Alex);
   EXPECT_EQ(alex.backbone, fs::path("/cache/torch/hub/checkpoints/alexnet-owt-7be5be79.pth"));
   // The development data's copy, found from any working directory.
-  EXPECT_EQ(alex.heads, priors::sr::default_weights_dir() / "lpips/v0.1/alex.pth");
+  EXPECT_EQ(alex.heads, priors::default_weights_dir() / "lpips/v0.1/alex.pth");
   EXPECT_TRUE(alex.heads.is_absolute()) << alex.heads;
 }
 

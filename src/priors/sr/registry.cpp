@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cstdlib>
 #include <functional>
 #include <map>
 #include <regex>
@@ -151,11 +150,6 @@ const std::map<std::string, Factory>& factories() {
 }
 
 }  // namespace
-
-fs::path default_weights_dir() {
-  if (const char* dir = std::getenv("IESRGS_WEIGHTS_DIR"); dir && *dir) return dir;
-  return IESRGS_DEV_WEIGHTS_DIR;
-}
 
 fs::path default_sr_weights(const std::string& model, int scale) {
   std::string upper = model;

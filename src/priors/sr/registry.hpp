@@ -1,15 +1,12 @@
 #pragma once
-// Where the super-resolution backends find their checkpoints, and which backends exist
+// Where the super-resolution backends find their checkpoints (below priors::default_weights_dir),
+// and which backends exist
 // (make_sr_net itself is declared in sr_net.hpp).
 #include <filesystem>
 #include <string>
 #include <vector>
 
 namespace iesrgs::priors::sr {
-
-// The root of the checkpoint folders: $IESRGS_WEIGHTS_DIR when set, else the development data
-// beside the source tree (../shared/data/weights), which may not exist on a user's machine.
-std::filesystem::path default_weights_dir();
 
 // The official file of `model` at `scale`: <weights dir>/sr/<MODEL>_x<scale>.pth, e.g.
 // SAFMN_x4.pth.

@@ -62,7 +62,8 @@ TEST(SrRegistry, DefaultWeightsFollowTheEnvironment) {
 
 TEST(SrRegistry, DefaultWeightsAreTheDevelopmentDataOtherwise) {
   ScopedEnv weights("IESRGS_WEIGHTS_DIR", std::nullopt);
-  EXPECT_EQ(default_weights_dir(), std::filesystem::path(IESRGS_SHARED_DATA) / "weights");
+  EXPECT_EQ(default_sr_weights("safmn", 4),
+            std::filesystem::path(IESRGS_SHARED_DATA) / "weights" / "sr" / "SAFMN_x4.pth");
 }
 
 TEST(SrRegistry, AutoPicksSafmnThenTheBestInstalledEsrganThenBicubic) {
