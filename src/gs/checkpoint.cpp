@@ -2,6 +2,7 @@
 
 #include <torch/serialize.h>
 
+#include <fstream>
 #include <string>
 
 #include "core/byte_reader.hpp"
@@ -66,14 +67,18 @@ void save_training_state(const std::filesystem::path& path, const GaussianModel&
   optimizer.save_state(archive);
   stats.save(archive);
   for (const auto& [name, value] : extras) archive.write("extra/" + name, value);
-  // Serialized in memory first: LibTorch's file writer throws from its destructor when the disk
-  // fills, which ends the process; the checked write below reports it and leaves no file.
-  std::string bytes;
-  archive.save_to([&bytes](const void* data, size_t size) {
-    bytes.append(static_cast<const char*>(data), size);
-    return size;
+  // Streamed to the file, not gathered in memory first: a string of the whole checkpoint (twice
+  // the model's parameters) set the peak memory of a training. LibTorch ends the process on a
+  // short write, so every write is reported whole and the stream's state checked afterwards.
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    archive.save_to([&out](const void* data, size_t size) {
+      out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+      return size;
+    });
+    out.close();
+    if (!out) fail_file(path, "write failed (disk full or not writable?)");
   });
-  write_file_atomically(path, bytes);
 }
 
 void load_training_state(const std::filesystem::path& path, GaussianModel& model,

@@ -79,9 +79,9 @@ bool all_finite(const gs::GaussianModel& model) {
 }
 
 // Parameters, gradients, Adam moments, densification statistics and the per-view projection
-// buffers: the peak resident memory grows by about 1.8 KB per Gaussian (measured from 0.1M to 1M
+// buffers: the peak resident memory grows by about 1.5 KB per Gaussian (measured from 0.1M to 1M
 // random points, docs/DATASETS.md).
-constexpr int64_t kBytesPerGaussian = 1800;
+constexpr int64_t kBytesPerGaussian = 1500;
 
 // The trainer's own model on `device`: copied only when it is elsewhere.
 void place_on(gs::GaussianModel& model, torch::Device device) {
