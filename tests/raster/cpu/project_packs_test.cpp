@@ -8,7 +8,7 @@
 #include "raster/cpu/dispatch.hpp"
 #include "raster/cpu/kernels.hpp"
 #include "raster/project.hpp"
-#include "raster_test_scene.hpp"
+#include "raster/raster_test_scene.hpp"
 #include "support/active_isa.hpp"
 #include "support/compare.hpp"
 

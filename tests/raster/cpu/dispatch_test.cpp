@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "raster/cpu/dispatch.hpp"
-#include "raster_test_scene.hpp"
+#include "raster/raster_test_scene.hpp"
 #include "support/active_isa.hpp"
 
 namespace iesrgs::raster::testkit {
