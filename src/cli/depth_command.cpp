@@ -9,11 +9,11 @@
 #include "cli/validators.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "core/progress.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "priors/depth/depth_files.hpp"
 #include "priors/depth/depth_net.hpp"
-#include "train/progress.hpp"
 
 namespace iesrgs::cli {
 
@@ -34,7 +34,7 @@ void run_depth(const DepthArgs& args) {
       priors::depth::make_depth_net(args.model, args.weights, compute_device());
   if (!net) fail("depth: model '{}' predicts nothing, so there is nothing to write", args.model);
   const float background[3] = {args.background, args.background, args.background};
-  train::ItemPace pace(jobs.size());
+  ItemPace pace(jobs.size());
   for (size_t i = 0; i < jobs.size(); ++i) {
     const Image rgb = composite_rgb(read_image8(jobs[i].image), background);
     priors::depth::write_depth_outputs(net->predict(to_tensor(rgb).to(compute_device())).cpu(),

@@ -14,12 +14,12 @@
 #include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "core/paths.hpp"
+#include "core/progress.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "priors/sr/registry.hpp"
 #include "priors/sr/sr_net.hpp"
 #include "priors/sr/tiling.hpp"
-#include "train/progress.hpp"
 
 namespace iesrgs::cli {
 
@@ -93,7 +93,7 @@ void run(const UpscaleArgs& args) {
   use_device(args.device);
   const std::vector<Job> jobs = jobs_for(args.input, args.output);
   const std::unique_ptr<SrNet> net = priors::sr::make_sr_net(args.model, args.weights, args.scale);
-  train::ItemPace pace(jobs.size());
+  ItemPace pace(jobs.size());
   for (size_t i = 0; i < jobs.size(); ++i) {
     const auto [width, height] = upscale_one(*net, args, jobs[i]);
     fmt::print("[{}/{}] {} {}x{} -> {} {}x{} ({})\n", i + 1, jobs.size(), jobs[i].input.string(),

@@ -7,6 +7,7 @@
 
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "core/progress.hpp"
 #include "core/stopwatch.hpp"
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
@@ -18,7 +19,6 @@
 #include "priors/sr/esrgan.hpp"
 #include "priors/sr/registry.hpp"
 #include "priors/sr/sr_net.hpp"
-#include "train/progress.hpp"
 
 namespace iesrgs::pipeline {
 
@@ -130,7 +130,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
     // The views left may be cached: the estimate errs long.
     fmt::print("external {}/{} {}: {:.2f} s per view, ETA {}\n", i + 1, cameras.size(), camera.name,
                seconds / double(computed),
-               train::format_eta(computed, computed + cameras.size() - i - 1, seconds));
+               format_eta(computed, computed + cameras.size() - i - 1, seconds));
     std::fflush(stdout);
   }
   fmt::print("external stage: {} views computed, {} reused from {}\n", computed,

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/progress.hpp"
 #include "core/stopwatch.hpp"
 #include "eval/lpips.hpp"
 #include "eval/mask_agreement.hpp"
@@ -26,7 +27,6 @@
 #include "pipeline/rows.hpp"
 #include "pipeline/stage_record.hpp"
 #include "pipeline/training_stage.hpp"
-#include "train/progress.hpp"
 #include "train/session.hpp"
 
 namespace iesrgs::pipeline {
@@ -53,10 +53,10 @@ class HrRowProgress {
     const auto left =
         size_t(std::count(trains_.begin() + std::ptrdiff_t(done_), trains_.end(), true));
     fmt::print("HR rows: {} of {} done in {}{}\n", done_, trains_.size(),
-               train::format_duration(watch_.seconds()),
+               format_duration(watch_.seconds()),
                trained_ && left
                    ? fmt::format(", ETA {} for the rest",
-                                 train::format_eta(trained_, trained_ + left, trained_seconds_))
+                                 format_eta(trained_, trained_ + left, trained_seconds_))
                    : "");
   }
 

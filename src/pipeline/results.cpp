@@ -4,8 +4,8 @@
 
 #include <utility>
 
+#include "core/progress.hpp"
 #include "io/atomic_file.hpp"
-#include "train/progress.hpp"
 
 namespace iesrgs::pipeline {
 
@@ -37,7 +37,7 @@ std::string stages_markdown(const RunResult& result) {
   std::string md = "| stage | time |\n|---|---|\n";
   const auto add = [&](const std::string& stage, const nlohmann::json& seconds) {
     if (seconds.is_number())
-      md += fmt::format("| {} | {} |\n", stage, train::format_duration(seconds.get<double>()));
+      md += fmt::format("| {} | {} |\n", stage, format_duration(seconds.get<double>()));
   };
   const auto entry = [&](const char* key, const std::string& row = "") {
     const nlohmann::json& value = stages.contains(key) ? stages[key] : nlohmann::json();
@@ -83,7 +83,7 @@ std::string results_markdown(const RunResult& result) {
                       row.from_earlier_run ? " *" : "", format_metric(row, row.mean.psnr, 2),
                       format_metric(row, row.mean.ssim, 4),
                       row.mean.lpips ? fmt::format("{:.4f}", *row.mean.lpips) : "-",
-                      train::format_duration(row.train_seconds), row.fps);
+                      format_duration(row.train_seconds), row.fps);
   }
   if (earlier) md += "\n\\* from an earlier run in this folder with the same settings\n";
   return md + "\n" + stages_markdown(result);

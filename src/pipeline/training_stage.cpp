@@ -3,10 +3,10 @@
 #include <fmt/core.h>
 
 #include "core/error.hpp"
+#include "core/progress.hpp"
 #include "io/atomic_file.hpp"
 #include "io/ply.hpp"
 #include "pipeline/stage_record.hpp"
-#include "train/progress.hpp"
 #include "train/session.hpp"
 
 namespace iesrgs::pipeline {
@@ -79,7 +79,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   train::write_point_clouds(dir, trainer.model());
   record_stage(dir, identity, true, summary.seconds);
   fmt::print("{}: {} Gaussians after {} ({:.2f} it/s)\n", name, summary.gaussians,
-             train::format_duration(summary.seconds), summary.iterations_per_second);
+             format_duration(summary.seconds), summary.iterations_per_second);
   return {trainer.model(), summary.seconds, false};
 }
 

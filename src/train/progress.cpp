@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "core/error.hpp"
+#include "core/progress.hpp"
 #include "io/atomic_file.hpp"
 
 namespace iesrgs::train {
@@ -82,28 +83,6 @@ void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
   std::fflush(stdout);
   last_print_ = now;
   last_print_iteration_ = iteration;
-}
-
-std::string format_eta(size_t done, size_t total, double seconds) {
-  if (done == 0) return "?";
-  return format_duration(seconds / double(done) * double(total - std::min(done, total)));
-}
-
-ItemPace::ItemPace(size_t total) : total_(total), first_(Clock::now()), last_(first_) {}
-
-std::string ItemPace::finished(size_t done) {
-  const Clock::time_point now = Clock::now();
-  const std::chrono::duration<double> item = now - last_, all = now - first_;
-  last_ = now;
-  return fmt::format("{:.2f} s, ETA {}", item.count(), format_eta(done, total_, all.count()));
-}
-
-std::string format_duration(double seconds) {
-  const int64_t total = std::llround(std::max(0.0, seconds));
-  const int64_t h = total / 3600, m = total / 60 % 60, s = total % 60;
-  if (h > 0) return fmt::format("{}h{:02}m{:02}s", h, m, s);
-  if (m > 0) return fmt::format("{}m{:02}s", m, s);
-  return fmt::format("{}s", s);
 }
 
 }  // namespace iesrgs::train

@@ -36,25 +36,4 @@ class ProgressLog {
   double smoothed_loss_ = 0;
 };
 
-// "1h02m05s", "3m07s", "42s".
-std::string format_duration(double seconds);
-
-// The time left for `total` items when `done` of them took `seconds`, at their mean pace.
-std::string format_eta(size_t done, size_t total, double seconds);
-
-// Times a loop over `total` items, for its per-item progress lines.
-class ItemPace {
- public:
-  explicit ItemPace(size_t total);
-
-  // When the `done`-th item has finished: the seconds it took and the ETA of the rest,
-  // "0.42 s, ETA 1m03s".
-  std::string finished(size_t done);
-
- private:
-  using Clock = std::chrono::steady_clock;
-  size_t total_;
-  Clock::time_point first_, last_;
-};
-
 }  // namespace iesrgs::train
