@@ -168,9 +168,10 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
   warn_if_lpips_unavailable();
 }
 
-// Before the trainings, not after the first of them: the table will show "-" for LPIPS.
+// Before the trainings, not after the first of them: the table will show "-" for LPIPS. The
+// internal stage alone scores nothing.
 void Pipeline::warn_if_lpips_unavailable() const {
-  if (!hr_images_ || o_.lpips == "none") return;
+  if (!hr_images_ || o_.lpips == "none" || o_.only == StageSelection::Internal) return;
   const eval::LpipsNet net = eval::parse_lpips_net(o_.lpips);
   if (const auto missing = eval::lpips_unavailable_reason(net, eval::default_lpips_weights(net)))
     spdlog::warn("LPIPS ({}) unavailable: {}", o_.lpips, *missing);

@@ -13,7 +13,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
-#include "priors/sr/registry.hpp"
+#include "priors/state_dict.hpp"
 #include "support/expect_error.hpp"
 #include "support/scoped_env.hpp"
 #include "support/temp_dir.hpp"
