@@ -21,14 +21,14 @@ struct TrainingArgs {
   int64_t iterations = 0;
   int views_per_iteration;
   std::vector<std::string> assignments;
-  std::string set_flag = "--set";  // the option that gives them, named in errors
+  std::string option_prefix = "--";  // "--" or "--internal-": named in errors
 
   train::TrainConfig resolve(uint64_t seed) const {
     train::TrainConfig config = train::make_preset(preset, iterations);
     config.views_per_iteration = views_per_iteration;
     config.seed = seed;
     for (const std::string& assignment : assignments)
-      train::apply_assignment(config, assignment, set_flag);
+      train::apply_assignment(config, assignment, option_prefix);
     train::validate(config);
     return config;
   }
@@ -74,8 +74,8 @@ void add_training_options(CLI::App& command, TrainingArgs& args, const std::stri
                   what + " views per iteration (multi-view regulation K)")
       ->check(kPositive)
       ->capture_default_str();
-  args.set_flag = prefix + "set";
-  command.add_option(args.set_flag, args.assignments,
+  args.option_prefix = prefix;
+  command.add_option(prefix + "set", args.assignments,
                      what + " training parameter key=value (repeatable; see config.json)");
 }
 

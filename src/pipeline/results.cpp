@@ -39,19 +39,18 @@ std::string stages_markdown(const RunResult& result) {
     if (seconds.is_number())
       md += fmt::format("| {} | {} |\n", stage, format_duration(seconds.get<double>()));
   };
-  const auto entry = [&](const char* key, const std::string& row = "") {
-    const nlohmann::json& value = stages.contains(key) ? stages[key] : nlohmann::json();
-    if (row.empty()) return value;
-    return value.is_object() && value.contains(row) ? value[row] : nlohmann::json();
+  // A missing entry is null, which `add` skips.
+  const auto entry = [](const nlohmann::json& object, const std::string& key) {
+    return object.is_object() ? object.value(key, nlohmann::json()) : nlohmann::json();
   };
-  add("external knowledge (E_image, E_depth)", entry("external_seconds"));
-  add("internal model (LR Mip-Splatting)", entry("internal_training_seconds"));
-  add("SR-splatting (I_image, I_depth at HR)", entry("sr_splatting_seconds"));
+  add("external knowledge (E_image, E_depth)", entry(stages, "external_seconds"));
+  add("internal model (LR Mip-Splatting)", entry(stages, "internal_training_seconds"));
+  add("SR-splatting (I_image, I_depth at HR)", entry(stages, "sr_splatting_seconds"));
   for (const RowResult& row : result.rows)
-    add("HR training, " + row.id, entry("fusion_seconds", row.id));
+    add("HR training, " + row.id, entry(entry(stages, "fusion_seconds"), row.id));
   for (const RowResult& row : result.rows)
-    add("rendering and scoring, " + row.id, entry("evaluation_seconds", row.id));
-  add("this run in all", entry("total_seconds_this_run"));
+    add("rendering and scoring, " + row.id, entry(entry(stages, "evaluation_seconds"), row.id));
+  add("this run in all", entry(stages, "total_seconds_this_run"));
   return md;
 }
 

@@ -135,14 +135,16 @@ void apply_json(TrainConfig& config, const nlohmann::json& json, const std::stri
   }
 }
 
-void apply_assignment(TrainConfig& config, const std::string& assignment, const std::string& flag) {
+void apply_assignment(TrainConfig& config, const std::string& assignment,
+                      const std::string& option_prefix) {
+  const std::string flag = option_prefix + "set";
   const size_t eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0) fail("{} \"{}\": expected key=value", flag, assignment);
   const std::string key = assignment.substr(0, eq), text = assignment.substr(eq + 1);
   // The preset names where the schedule came from; setting the name alone would mislabel it.
   if (key == "preset")
     fail("{} \"{}\": the preset is chosen with {}, which also sets its schedule", flag, assignment,
-         flag.substr(0, flag.size() - 3) + "preset");
+         option_prefix + "preset");
   nlohmann::json value = nlohmann::json::parse(text, nullptr, false);
   if (value.is_discarded()) value = text;
   apply_json(config, nlohmann::json{{key, value}}, flag + " " + assignment);

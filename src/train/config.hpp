@@ -66,10 +66,10 @@ void rescale_schedule(TrainConfig& config, int64_t iterations);
 nlohmann::json to_json(const TrainConfig& config);
 // Overrides the fields present in `json`; unknown keys and wrong types are errors naming `origin`.
 void apply_json(TrainConfig& config, const nlohmann::json& json, const std::string& origin);
-// "key=value" overrides from the command line (value parsed as JSON, else taken as a string);
-// errors name the option `flag` that gave it.
+// "key=value" overrides from the command line (value parsed as JSON, else taken as a string),
+// given with <option_prefix>set; errors name that option.
 void apply_assignment(TrainConfig& config, const std::string& assignment,
-                      const std::string& flag = "--set");
+                      const std::string& option_prefix = "--");
 
 // Throws Error naming the first inconsistent field.
 void validate(const TrainConfig& config);

@@ -82,11 +82,11 @@ TEST(TrainConfig, BadInputNamesTheProblem) {
             std::string::npos);
   // The HR and LR stages of `run` take their overrides from two options; errors name the one used.
   EXPECT_NE(error_message([&] {
-              apply_assignment(c, "bogus=1", "--internal-set");
+              apply_assignment(c, "bogus=1", "--internal-");
             }).find("--internal-set bogus=1: unknown training parameter \"bogus\""),
             std::string::npos);
   EXPECT_NE(error_message([&] {
-              apply_assignment(c, "preset=paper", "--internal-set");
+              apply_assignment(c, "preset=paper", "--internal-");
             }).find("chosen with --internal-preset"),
             std::string::npos);
   EXPECT_NE(error_message([] { make_preset("turbo"); }).find("turbo"), std::string::npos);

@@ -1,7 +1,6 @@
 #pragma once
 // Where the super-resolution backends find their checkpoints (below priors::default_weights_dir),
-// and which backends exist
-// (make_sr_net itself is declared in sr_net.hpp).
+// and which backends exist (make_sr_net itself is declared in sr_net.hpp).
 #include <filesystem>
 #include <string>
 #include <vector>
