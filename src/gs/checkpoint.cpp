@@ -3,6 +3,7 @@
 #include <torch/serialize.h>
 
 #include <fstream>
+#include <memory>
 #include <string>
 
 #include "core/byte_reader.hpp"
@@ -10,6 +11,7 @@
 #include "core/torch_error.hpp"
 #include "gs/sh.hpp"
 #include "io/atomic_file.hpp"
+#include "io/mapped_file.hpp"
 #include "io/zip_archive.hpp"
 
 namespace iesrgs::gs {
@@ -84,12 +86,15 @@ void save_training_state(const std::filesystem::path& path, const GaussianModel&
 void load_training_state(const std::filesystem::path& path, GaussianModel& model,
                          GaussianOptimizer& optimizer, DensifyStats& stats,
                          CheckpointExtras* extras) {
-  const std::string bytes = read_file(path);
+  // Checked through a mapping, then read by LibTorch from the file: a copy of the whole file
+  // beside the tensors loaded from it set the peak memory of a resume.
+  auto file = std::make_unique<MappedFile>(path);
   try {
     // LibTorch's reader skips the CRCs, so damaged bytes would load as a different model.
-    ZipArchive(bytes).check_all();
+    ZipArchive(file->bytes()).check_all();
+    file.reset();
     torch::serialize::InputArchive archive;
-    archive.load_from(bytes.data(), bytes.size(), torch::kCPU);  // wherever it was trained
+    archive.load_from(path.string(), torch::kCPU);  // wherever it was trained
     GaussianModel loaded_model = load_model(archive);
     GaussianOptimizer loaded_optimizer = optimizer;
     loaded_optimizer.load_state(archive, loaded_model);

@@ -4,10 +4,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <fstream>
-#include <sstream>
 #include <string_view>
 #include <system_error>
 
@@ -87,10 +87,15 @@ std::string read_file(const fs::path& path) {
   if (fs::is_directory(path, ec)) fail_file(path, "is a directory, expected a file");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail_file(path, "cannot open for reading");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
+  // Appended into a string reserved at the file's size (pipes have none): a stringstream grows by
+  // doubling and then copies, and peaked at twice the size of the file (1.4 GB for 0.7 GB).
+  std::string bytes;
+  if (const auto size = fs::file_size(path, ec); !ec) bytes.reserve(size);
+  std::array<char, 1 << 16> chunk;
+  while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0)
+    bytes.append(chunk.data(), in.gcount());
   if (in.bad()) fail_file(path, "read error");
-  return buffer.str();
+  return bytes;
 }
 
 }  // namespace iesrgs
