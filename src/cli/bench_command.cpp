@@ -119,7 +119,7 @@ RasterWorkload trained_workload(const RasterBenchArgs& args) {
     if (int(w.cameras.size()) == args.views) break;
     w.cameras.push_back(raster::raster_camera<float>(camera->scaled(args.scale)));
   }
-  w.trained = model.render_tensors();
+  w.trained = raster::render_tensors(model);
   w.params = raster::kernel_params(w.trained);
   w.description =
       fmt::format("{}, {} Gaussians, {} training views of {} at {}x{}", args.model, model.size(),

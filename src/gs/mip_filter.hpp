@@ -5,7 +5,7 @@
 // unchanged. 2D mip filter: the screen-space covariance gets kMipFilterVariance on its diagonal
 // and the opacity the matching factor. Models trained without it (3DGS, most .spz files) are
 // drawn with 3DGS's dilation instead, as they were trained: more variance, opacity unchanged.
-#include "raster/geometry.hpp"
+#include "core/geometry.hpp"
 
 namespace iesrgs::gs {
 
@@ -51,22 +51,22 @@ IESRGS_HD double filter2d_variance(bool antialiased) {
 
 // Returns the opacity factor (1 for the dilation) and writes the filtered covariance.
 template <typename T>
-IESRGS_HD T filter2d(const raster::Sym2<T>& cov, bool antialiased, raster::Sym2<T>& filtered) {
+IESRGS_HD T filter2d(const Sym2<T>& cov, bool antialiased, Sym2<T>& filtered) {
   const T h = T(filter2d_variance(antialiased));
   filtered = {cov.xx + h, cov.xy, cov.yy + h};
   if (!antialiased) return T(1);
-  return hd::sqrt(hd::max(T(kMinMipDetRatio), raster::det(cov) / raster::det(filtered)));
+  return hd::sqrt(hd::max(T(kMinMipDetRatio), det(cov) / det(filtered)));
 }
 
 // dL/dcov from dL/dfiltered and dL/dfactor (no factor gradient where the floor is active).
 template <typename T>
-IESRGS_HD raster::Sym2<T> filter2d_backward(const raster::Sym2<T>& cov, bool antialiased,
-                                            const raster::Sym2<T>& dfiltered, T dfactor) {
-  raster::Sym2<T> dcov = dfiltered;
+IESRGS_HD Sym2<T> filter2d_backward(const Sym2<T>& cov, bool antialiased, const Sym2<T>& dfiltered,
+                                    T dfactor) {
+  Sym2<T> dcov = dfiltered;
   if (!antialiased) return dcov;
-  raster::Sym2<T> filtered;
+  Sym2<T> filtered;
   const T factor = filter2d(cov, antialiased, filtered);
-  const T det0 = raster::det(cov), det1 = raster::det(filtered);
+  const T det0 = det(cov), det1 = det(filtered);
   const T r = det0 / det1;
   // factor = sqrt(det0 / det1); d det / d(xx, xy, yy) = (yy, -2 xy, xx)
   const T g = hd::select(r <= T(kMinMipDetRatio), T(0), dfactor / (T(2) * factor * det1));

@@ -83,11 +83,6 @@ const torch::Tensor& GaussianModel::param(Param p) const {
   fail("unknown Gaussian parameter {}", int(p));
 }
 
-raster::GaussianTensors GaussianModel::render_tensors() const {
-  return {means,     log_scales,       quats,      opacity_logits, sh_dc, sh_rest,
-          filter_3d, active_sh_degree, antialiased};
-}
-
 GaussianModel GaussianModel::clone() const {
   return to(means.device());
 }

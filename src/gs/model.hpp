@@ -11,7 +11,6 @@
 #include "io/camera.hpp"
 #include "io/ply.hpp"
 #include "io/scene.hpp"
-#include "raster/autograd.hpp"
 
 namespace iesrgs::gs {
 
@@ -33,9 +32,6 @@ struct GaussianModel {
   int64_t size() const { return means.size(0); }
   torch::Tensor& param(Param p);
   const torch::Tensor& param(Param p) const;
-
-  // The tensors the rasterizer takes: the parameters themselves, so gradients reach them.
-  raster::GaussianTensors render_tensors() const;
 
   // A copy that shares no storage with this model. Copying the struct shares the tensors, and
   // the optimizer updates them in place, so training such a copy would change this model too.

@@ -3,7 +3,7 @@
 // color = max(0, sum_k basis_k(dir) * sh_k + 0.5), dir the unit vector from the camera center to
 // the Gaussian's mean. Coefficients are stored (16, 3) per Gaussian whatever the active degree,
 // band 0 apart from the others as 3DGS models keep them (sh_dc (N, 1, 3), sh_rest (N, 15, 3)).
-#include "raster/geometry.hpp"
+#include "core/geometry.hpp"
 
 namespace iesrgs::gs {
 
@@ -27,7 +27,7 @@ IESRGS_HD int sh_count(int degree) {
 // Basis values b[k] at the unit direction (x, y, z) and, when grad != nullptr, their gradients
 // grad[k] with respect to (x, y, z).
 template <typename T>
-IESRGS_HD void sh_basis(int degree, T x, T y, T z, T* b, raster::Vec3T<T>* grad) {
+IESRGS_HD void sh_basis(int degree, T x, T y, T z, T* b, Vec3T<T>* grad) {
   const T c0 = T(0.28209479177387814), c1 = T(0.4886025119029199);
   const T c2[5] = {T(1.0925484305920792), T(-1.0925484305920792), T(0.31539156525252005),
                    T(-1.0925484305920792), T(0.5462742152960396)};
@@ -80,12 +80,10 @@ IESRGS_HD void sh_basis(int degree, T x, T y, T z, T* b, raster::Vec3T<T>* grad)
 
 // Color seen along `view` (camera center to mean, any length).
 template <typename T>
-IESRGS_HD void sh_to_color(int degree, ShBands<const T> sh, const raster::Vec3T<T>& view,
-                           T* color) {
-  const T inv = T(1) / hd::sqrt(raster::dot(view, view));
+IESRGS_HD void sh_to_color(int degree, ShBands<const T> sh, const Vec3T<T>& view, T* color) {
+  const T inv = T(1) / hd::sqrt(dot(view, view));
   T b[kShCoefficients];
-  sh_basis(degree, view.x * inv, view.y * inv, view.z * inv, b,
-           static_cast<raster::Vec3T<T>*>(nullptr));
+  sh_basis(degree, view.x * inv, view.y * inv, view.z * inv, b, static_cast<Vec3T<T>*>(nullptr));
   for (int c = 0; c < 3; ++c) {
     T sum = T(0.5);
     for (int k = 0; k < sh_count(degree); ++k) sum += b[k] * sh(k, c);
@@ -96,12 +94,12 @@ IESRGS_HD void sh_to_color(int degree, ShBands<const T> sh, const raster::Vec3T<
 // Gradients of the coefficients (written to dsh, all 16 rows; rows beyond the degree get zero)
 // and of `view` (added to dview) from dcolor. Channels clamped at zero pass no gradient.
 template <typename T>
-IESRGS_HD void sh_to_color_backward(int degree, ShBands<const T> sh, const raster::Vec3T<T>& view,
-                                    const T* dcolor, ShBands<T> dsh, raster::Vec3T<T>& dview) {
-  const T inv = T(1) / hd::sqrt(raster::dot(view, view));
-  const raster::Vec3T<T> dir = inv * view;
+IESRGS_HD void sh_to_color_backward(int degree, ShBands<const T> sh, const Vec3T<T>& view,
+                                    const T* dcolor, ShBands<T> dsh, Vec3T<T>& dview) {
+  const T inv = T(1) / hd::sqrt(dot(view, view));
+  const Vec3T<T> dir = inv * view;
   T b[kShCoefficients];
-  raster::Vec3T<T> db[kShCoefficients];
+  Vec3T<T> db[kShCoefficients];
   sh_basis(degree, dir.x, dir.y, dir.z, b, db);
   const int count = sh_count(degree);
   T live[3];
@@ -110,14 +108,14 @@ IESRGS_HD void sh_to_color_backward(int degree, ShBands<const T> sh, const raste
     for (int k = 0; k < count; ++k) sum += b[k] * sh(k, c);
     live[c] = hd::select(sum < T(0), T(0), dcolor[c]);
   }
-  raster::Vec3T<T> ddir{0, 0, 0};
+  Vec3T<T> ddir{0, 0, 0};
   for (int k = 0; k < kShCoefficients; ++k)
     for (int c = 0; c < 3; ++c) {
       dsh(k, c) = k < count ? b[k] * live[c] : T(0);
       if (k < count) ddir = ddir + (live[c] * sh(k, c)) * db[k];
     }
   // Through the normalization of the view direction.
-  dview = dview + inv * (ddir - raster::dot(ddir, dir) * dir);
+  dview = dview + inv * (ddir - dot(ddir, dir) * dir);
 }
 
 }  // namespace iesrgs::gs

@@ -35,8 +35,8 @@ Image8 gray_image8(const torch::Tensor& plane) {
 RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
                          const std::array<float, 3>& background) {
   torch::NoGradGuard no_grad;
-  const raster::RenderOutput out =
-      raster::render(model.render_tensors(), raster::raster_camera<float>(camera), background);
+  const raster::RenderOutput out = raster::render(raster::render_tensors(model),
+                                                  raster::raster_camera<float>(camera), background);
   const torch::Tensor drawn = out.alpha > kMinAlphaForDepth;
   RenderedView view;  // on the CPU, wherever the model renders
   view.image = out.image.clamp(0, 1).cpu();

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "gs/model.hpp"
 #include "gs/sh.hpp"
 #include "raster/frame.hpp"
 #include "raster/rasterizer.hpp"
@@ -204,6 +205,12 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
 };
 
 }  // namespace
+
+GaussianTensors render_tensors(const gs::GaussianModel& model) {
+  return {model.means,      model.log_scales, model.quats,     model.opacity_logits,
+          model.sh_dc,      model.sh_rest,    model.filter_3d, model.active_sh_degree,
+          model.antialiased};
+}
 
 RenderOutput render(const GaussianTensors& gaussians, const RasterCamera<float>& camera,
                     const std::array<float, 3>& background, const ViewspaceProbes& probes) {

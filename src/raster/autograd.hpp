@@ -8,6 +8,10 @@
 
 #include "raster/types.hpp"
 
+namespace iesrgs::gs {
+struct GaussianModel;
+}
+
 namespace iesrgs::raster {
 
 struct GaussianTensors {
@@ -21,6 +25,9 @@ struct GaussianTensors {
   int sh_degree = 0;
   bool antialiased = true;  // Mip-Splatting's 2D filter; false: 3DGS's dilation
 };
+
+// The tensors of a model: its parameters themselves, so that gradients reach them.
+GaussianTensors render_tensors(const gs::GaussianModel& model);
 
 struct RenderOutput {
   torch::Tensor image;  // (3, H, W) over the background

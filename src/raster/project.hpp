@@ -4,9 +4,9 @@
 // smoothing filter and 2D mip filter, or 3DGS's dilation for models trained without it. The
 // backward pass recomputes the forward intermediates. T is float or double on one Gaussian, or a
 // pack of floats with one Gaussian per SIMD lane (raster/cpu/lanes.hpp), hence no branch on data.
+#include "core/geometry.hpp"
 #include "gs/mip_filter.hpp"
 #include "gs/sh.hpp"
-#include "raster/geometry.hpp"
 #include "raster/types.hpp"
 
 namespace iesrgs::raster {

@@ -236,7 +236,7 @@ double Trainer::step(int64_t iteration) {
     raster::ViewspaceProbes probes{torch::zeros({model_.size(), 2}, probe_options),
                                    torch::zeros({model_.size(), 2}, probe_options)};
     const raster::RenderOutput render =
-        raster::render(model_.render_tensors(), raster::raster_camera<float>(view.camera),
+        raster::render(raster::render_tensors(model_), raster::raster_camera<float>(view.camera),
                        setup_.background, probes);
     const torch::Tensor loss =
         setup_.loss ? setup_.loss(v, render)
@@ -315,8 +315,9 @@ double Trainer::evaluate_psnr(const std::vector<TrainView>& views) const {
   torch::NoGradGuard no_grad;
   double sum = 0;
   for (const TrainView& view : views) {
-    const raster::RenderOutput render = raster::render(
-        model_.render_tensors(), raster::raster_camera<float>(view.camera), setup_.background);
+    const raster::RenderOutput render =
+        raster::render(raster::render_tensors(model_), raster::raster_camera<float>(view.camera),
+                       setup_.background);
     sum += psnr(render.image, view.target);
   }
   return views.empty() ? 0 : sum / double(views.size());

@@ -148,18 +148,6 @@ TEST(GaussianModel, LowerDegreeCloudsGetZeroHigherBands) {
             std::string::npos);
 }
 
-TEST(GaussianModel, RenderTensorsAreTheParameters) {
-  const GaussianModel m = filtered_model(3);
-  const raster::GaussianTensors t = m.render_tensors();
-  for (int p = 0; p < kParamCount; ++p) {
-    const torch::Tensor& given = *std::array{&t.means,          &t.sh_dc,      &t.sh_rest,
-                                             &t.opacity_logits, &t.log_scales, &t.quats}[size_t(p)];
-    EXPECT_TRUE(given.is_same(m.param(Param(p)))) << p;
-  }
-  EXPECT_TRUE(t.filter_std.is_same(m.filter_3d));
-  EXPECT_EQ(t.sh_degree, 2);
-}
-
 TEST(GaussianModel, CloneSharesNoStorage) {
   const GaussianModel original = filtered_model(4);
   const GaussianModel before = original.clone();

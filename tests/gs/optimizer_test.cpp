@@ -9,6 +9,8 @@
 #include "gs/densify.hpp"
 #include "gs/random_model.hpp"
 #include "io/atomic_file.hpp"
+#include "raster/autograd.hpp"
+#include "raster/rasterizer.hpp"
 #include "raster/raster_test_scene.hpp"
 #include "support/cuda_device.hpp"
 #include "support/expect_error.hpp"
@@ -204,8 +206,8 @@ TEST(GaussianOptimizer, OneStepThroughTheRasterizerLowersL1) {
   const raster::ViewspaceProbes probes{torch::zeros({3, 2}, torch::requires_grad()),
                                        torch::zeros({3, 2}, torch::requires_grad())};
   const auto l1 = [&] {
-    const auto out =
-        raster::render(m.render_tensors(), raster::raster_camera<float>(view), {0, 0, 0}, probes);
+    const auto out = raster::render(raster::render_tensors(m), raster::raster_camera<float>(view),
+                                    {0, 0, 0}, probes);
     return (out.image - torch::full({3, 24, 32}, 0.8f)).abs().mean();
   };
   GaussianOptimizer opt(m, {}, 1);

@@ -4,6 +4,8 @@
 #include <torch/torch.h>
 
 #include "core/error.hpp"
+#include "gs/model.hpp"
+#include "gs/random_model.hpp"
 #include "raster_test_scene.hpp"
 #include "support/cuda_device.hpp"
 
@@ -172,6 +174,20 @@ TEST(RasterAutograd, RejectsWrongShapes) {
   } catch (const Error& e) {
     EXPECT_STREQ(e.what(), "render: this build has no rasterizer for tensors on meta");
   }
+}
+
+TEST(RenderTensors, AreTheModelsParameters) {
+  gs::GaussianModel m = gs::random_model(3);
+  m.filter_3d = torch::rand({3});
+  m.active_sh_degree = 2;
+  const GaussianTensors t = render_tensors(m);
+  for (int p = 0; p < gs::kParamCount; ++p) {
+    const torch::Tensor& given = *std::array{&t.means,          &t.sh_dc,      &t.sh_rest,
+                                             &t.opacity_logits, &t.log_scales, &t.quats}[size_t(p)];
+    EXPECT_TRUE(given.is_same(m.param(gs::Param(p)))) << p;
+  }
+  EXPECT_TRUE(t.filter_std.is_same(m.filter_3d));
+  EXPECT_EQ(t.sh_degree, 2);
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
 #pragma once
-// Fixed-size vectors and matrices for the raster math, templated on the scalar so that the same
+// Fixed-size vectors and matrices for the kernels' math, templated on the scalar so that the same
 // kernels run in float (production) and double (gradient checks).
 #include "core/hd.hpp"
 
-namespace iesrgs::raster {
+namespace iesrgs {
 
 template <typename T>
 struct Vec3T {
@@ -118,4 +118,4 @@ IESRGS_HD void quat_to_rotation_backward(const T* q, const Mat3T<T>& dr, T* dq) 
   for (int i = 0; i < 4; ++i) dq[i] = (dn[i] - n[i] * radial) * inv;
 }
 
-}  // namespace iesrgs::raster
+}  // namespace iesrgs
