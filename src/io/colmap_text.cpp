@@ -59,7 +59,9 @@ class TextReader {
   bool at_line_end() const { return line_.empty(); }
 
   std::string_view field(const char* what) {
-    const size_t end = std::min(line_.find(' '), line_.find('\t'));
+    // Stops at the first blank: a search for a tab alone ran to the end of the line for every
+    // field, quadratic in the length of a long track.
+    const size_t end = line_.find_first_of(" \t");
     const std::string_view token = line_.substr(0, end);
     if (token.empty()) fail(fmt::format("missing {}", what));
     line_ = trimmed(line_.substr(token.size()));
