@@ -198,6 +198,23 @@ TEST(Cli, UpscaleNeverWritesOverItsInputNorPngBytesUnderAnotherName) {
   EXPECT_FALSE(std::filesystem::exists(jpeg));
 }
 
+TEST(Cli, UpscaleRefusesAnOutputTooLargeBeforeUpscaling) {
+  TempDir dir;
+  const std::string image = (dir / "a.png").string(), output = (dir / "out.png").string();
+  write_png(image, Image8(6, 4, 3));
+  const CliRun huge = iesrgs("upscale --model bicubic --scale 2000000000 " + image + " " + output);
+  EXPECT_EQ(huge.status, 1);
+  EXPECT_EQ(last_line(huge.output),
+            "error: " + image +
+                ": upscaled, it would be 12000000000x8000000000 pixels (at most 65536 a side)");
+  // 65532x43688 fits a PNG, but not the memory of the machines this runs on (85 GiB).
+  const CliRun big = iesrgs("upscale --model bicubic --scale 10922 " + image + " " + output);
+  EXPECT_EQ(big.status, 1);
+  EXPECT_TRUE(contains(last_line(big.output), "not enough memory: upscaling " + image))
+      << big.output;
+  EXPECT_FALSE(std::filesystem::exists(output));
+}
+
 TEST(Cli, ExportNeverWritesOverItsModel) {
   TempDir dir;
   SplatCloud cloud;

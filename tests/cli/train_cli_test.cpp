@@ -74,6 +74,13 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   for (const char* folder : {"rgb", "depth", "alpha"})
     EXPECT_FALSE(std::filesystem::exists(dir / "orbit" / folder / "path_0002.png")) << folder;
   EXPECT_TRUE(std::filesystem::exists(dir / "orbit" / "rgb" / "path_0001.png"));
+  // The largest render allowed needs 256 GiB: refused before the kernel kills the process.
+  const CliRun huge =
+      iesrgs("render " + out + " " + scene + " -o " + (dir / "huge").string() + " --scale 2048");
+  EXPECT_EQ(huge.status, 1);
+  EXPECT_TRUE(contains(last_line(huge.output), "not enough memory: rendering 65536x65536 views"))
+      << huge.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "huge" / "rgb"));
   // A render.json naming files outside its folder removes none of them.
   write_file_atomically(dir / "keep.png", "x");
   write_file_atomically(dir / "orbit" / "render.json", R"({"names": ["../../keep"]})");
