@@ -17,6 +17,7 @@
 #include "core/device.hpp"
 #include "core/error.hpp"
 #include "core/memory.hpp"
+#include "core/torch_error.hpp"
 #include "eval/metrics.hpp"
 #include "gs/checkpoint.hpp"
 #include "gs/densify.hpp"
@@ -170,24 +171,50 @@ void Trainer::load_checkpoint() {
                               {"seconds", {}},   {"loss", {}},     {"test_psnr", {}},
                               {"background", {}}};
   gs::load_training_state(path, model_, *optimizer_, stats_, &extras);  // onto the CPU
+  // A model that diverged is never saved, so these were damaged or written by another program;
+  // training from them would only diverge again, blaming the images.
+  if (!all_finite(model_)) fail_file(path, "holds non-finite parameters (not saved by training)");
   place_on(model_, device_);
   optimizer_->to(device_);
   stats_.to(device_);
+  try {
+    restore_extras(extras);
+  } catch (const c10::Error& e) {
+    fail_file(path, "not a readable training checkpoint (" + torch_error_line(e) + ")");
+  }
+  checkpoint_iteration_ = iteration_;
+}
+
+void Trainer::restore_extras(gs::CheckpointExtras& extras) {
+  const std::filesystem::path path = checkpoint_path();
   for (const char* required : {"iteration", "view_rng", "torch_rng"})
     if (!extras[required].defined())
       fail_file(path, fmt::format("not a training checkpoint of iesrgs train (no {})", required));
+  // Checkpoints of older versions lack all but the required ones.
+  const auto stored = [&](const char* name) {
+    const torch::Tensor& value = extras[name];
+    if (value.defined() && value.numel() != 1)
+      fail_file(path, fmt::format("not a training checkpoint of iesrgs train ({} holds {} values, "
+                                  "not one)",
+                                  name, value.numel()));
+    return value.defined() ? value.item<double>() : 0.0;
+  };
   // The training images are composited over it: another one would change what the run learns.
-  if (extras["background"].defined() && !extras["background"].equal(background_tensor()))
+  const torch::Tensor background = extras["background"].defined()
+                                       ? extras["background"].to(torch::kFloat).flatten()
+                                       : background_tensor();
+  if (!background.equal(background_tensor()))
     fail_file(path, fmt::format("the run trained over the background {}, not {}: resume with the "
                                 "same --background",
-                                fmt::join(extras["background"].data_ptr<float>(),
-                                          extras["background"].data_ptr<float>() + 3, ","),
+                                fmt::join(background.data_ptr<float>(),
+                                          background.data_ptr<float>() + background.numel(), ","),
                                 fmt::join(setup_.background, ",")));
-  iteration_ = extras["iteration"].item<int64_t>();
-  // Checkpoints of older versions lack these.
-  const auto stored = [&](const char* name) {
-    return extras[name].defined() ? extras[name].item<double>() : 0.0;
-  };
+  const double iteration = stored("iteration");
+  if (!(iteration >= 0 && iteration <= double(config_.iterations)))
+    fail_file(path, fmt::format("stored at iteration {}, outside the run's 0..{} (resume with the "
+                                "run's own --iterations)",
+                                iteration, config_.iterations));
+  iteration_ = int64_t(iteration);
   seconds_before_ = stored("seconds");
   last_loss_ = stored("loss");
   // 0 stands for no report: a real one of 0 dB would need an error of 1 on every pixel.
@@ -198,14 +225,18 @@ void Trainer::load_checkpoint() {
   auto generator = at::detail::getDefaultCPUGenerator();
   std::lock_guard<std::mutex> lock(generator.mutex());
   generator.set_state(extras["torch_rng"]);
-  checkpoint_iteration_ = iteration_;
 }
 
 void Trainer::require_same_cameras() const {
   // Resuming on other views (another --downscale, another scene) would go on training the model
   // on images it did not start from.
   const std::filesystem::path saved = cameras_path();
-  if (std::filesystem::exists(saved) && read_file(saved) != cameras_json(train_cameras_))
+  // Training writes it before its first checkpoint: a checkpoint without it came from elsewhere.
+  if (!std::filesystem::exists(saved))
+    fail_file(saved,
+              "missing beside the checkpoint, so the views it trained on are unknown: "
+              "train without --resume");
+  if (read_file(saved) != cameras_json(train_cameras_))
     fail_file(saved,
               "the run trained on other cameras than the scene given now: resume with the same "
               "scene and --downscale");

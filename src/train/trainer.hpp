@@ -15,6 +15,7 @@
 
 #include "core/device.hpp"
 #include "core/stopwatch.hpp"
+#include "gs/checkpoint.hpp"
 #include "gs/model.hpp"
 #include "io/camera.hpp"
 #include "raster/autograd.hpp"
@@ -94,6 +95,7 @@ class Trainer {
 
  private:
   void load_checkpoint();
+  void restore_extras(gs::CheckpointExtras& extras);  // the iteration, random states, ...
   // The training cameras as 3DGS saves them for viewers; also what --resume compares against.
   std::filesystem::path cameras_path() const { return setup_.output_dir / "cameras.json"; }
   void require_same_cameras() const;  // as cameras_path() holds them

@@ -4,7 +4,9 @@
 #include <torch/torch.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "core/device.hpp"
+#include "gs/checkpoint.hpp"
 #include "io/atomic_file.hpp"
 #include "io/ply.hpp"
 #include "loss/autograd.hpp"
@@ -242,6 +245,53 @@ TEST_F(TrainerTest, ResumeWithoutCheckpointIsAClearError) {
   EXPECT_NE(
       error_message([&] { Trainer::resumed(config(), setup(out.path())); }).find("no checkpoint"),
       std::string::npos);
+}
+
+// A checkpoint damaged or written by another program, yet a readable archive, is refused naming
+// the file, before any of it is trained on.
+TEST_F(TrainerTest, TamperedCheckpointsAreRefused) {
+  TempDir out;
+  TrainConfig c = config();
+  c.iterations = 4;
+  Trainer(c, setup(out.path()), initial()).run();
+  const std::filesystem::path file = out / "checkpoint.pt";
+  const std::string original = read_file(file);
+  // The error of resuming after `tamper` changed the stored state.
+  const auto resume_error =
+      [&](const std::function<void(gs::GaussianModel&, gs::CheckpointExtras&)>& tamper) {
+        gs::GaussianModel model;
+        gs::GaussianOptimizer optimizer(initial(), {}, 1);
+        gs::DensifyStats stats;
+        gs::CheckpointExtras extras{
+            {"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}}, {"background", {}}};
+        gs::load_training_state(file, model, optimizer, stats, &extras);
+        tamper(model, extras);
+        gs::save_training_state(file, model, optimizer, stats, extras);
+        const std::string message = error_message([&] { Trainer::resumed(c, setup(out.path())); });
+        write_file_atomically(file, original);
+        EXPECT_TRUE(testing::contains(message, file.string() + ": ")) << message;
+        return message;
+      };
+  using Extras = gs::CheckpointExtras;
+  EXPECT_TRUE(testing::contains(
+      resume_error([](auto&, Extras& e) { e["iteration"] = torch::tensor(int64_t(5)); }),
+      "stored at iteration 5, outside the run's 0..4"));
+  EXPECT_TRUE(testing::contains(resume_error([](auto&, Extras& e) {
+                                  e["iteration"] = torch::tensor({1, 2});
+                                }),
+                                "iteration holds 2 values, not one"));
+  EXPECT_TRUE(testing::contains(
+      resume_error([](auto&, Extras& e) { e["background"] = torch::tensor({0.5f}); }),
+      "trained over the background 0.5, not 1,1,1"));
+  EXPECT_TRUE(testing::contains(
+      resume_error([](auto&, Extras& e) { e["torch_rng"] = torch::zeros({3}, torch::kUInt8); }),
+      "not a readable training checkpoint ("));
+  EXPECT_TRUE(testing::contains(
+      resume_error([](gs::GaussianModel& m, Extras&) { m.means.data()[0][0] = NAN; }),
+      "holds non-finite parameters"));
+  std::filesystem::remove(out / "cameras.json");
+  EXPECT_TRUE(testing::contains(error_message([&] { Trainer::resumed(c, setup(out.path())); }),
+                                "cameras.json: missing beside the checkpoint"));
 }
 
 TEST_F(TrainerTest, EmptyStartingPlyIsAClearError) {
