@@ -15,8 +15,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A record whose fields have other types than record_stage writes was damaged from outside; it
+// counts as none, as an unreadable one does, and the stage trains again.
 nlohmann::json stage_json(const fs::path& dir) {
-  return read_stage_record(dir / "stage.json");
+  const nlohmann::json record = read_stage_record(dir / "stage.json");
+  const bool typed = record.value("finished", nlohmann::json(false)).is_boolean() &&
+                     record.value("seconds", nlohmann::json(0.0)).is_number();
+  return typed ? record : nlohmann::json::object();
 }
 
 // What a training stage's record must match: its inputs and its whole training config.
