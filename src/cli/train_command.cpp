@@ -64,6 +64,11 @@ train::TrainConfig resumed_config(const TrainArgs& args, const std::filesystem::
     fail_file(saved, "missing: --resume needs the output folder of an earlier run");
   train::TrainConfig config;
   train::apply_json(config, read_json_file(saved), saved.string());
+  try {
+    train::validate(config);  // an edited file: the error names it
+  } catch (const Error& e) {
+    fail_file(saved, e.what());
+  }
   spdlog::info("resuming with the config saved in {}", saved.string());
   if (!args.run_options_given) return config;
   const nlohmann::json kept = train::to_json(config),

@@ -255,6 +255,13 @@ TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {
   const CliRun resume = iesrgs("train " + scene + " -o " + (dir / "b").string() + " --resume");
   EXPECT_EQ(resume.status, 1);
   EXPECT_TRUE(contains(last_line(resume.output), "config.json: missing")) << resume.output;
+  // A saved config edited out of range is named on --resume.
+  write_file_atomically(dir / "b" / "config.json", R"({"max_sh_degree": 7})");
+  const CliRun edited = iesrgs("train " + scene + " -o " + (dir / "b").string() + " --resume");
+  EXPECT_EQ(edited.status, 1);
+  EXPECT_TRUE(contains(last_line(edited.output),
+                       "config.json: invalid training config: max_sh_degree must be 0..3"))
+      << edited.output;
   // Out-of-range numbers are refused before any work, in words.
   const CliRun none = iesrgs("train " + scene + " -o " + (dir / "c").string() + " --iterations 0");
   EXPECT_NE(none.status, 0);
