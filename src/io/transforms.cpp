@@ -55,10 +55,14 @@ const json& require(const json& object, const char* key, const Where& where) {
   return *value;
 }
 
-// JSON numbers are finite: the parser rejects overflowing literals.
+// JSON numbers are finite: the parser rejects overflowing literals. Those beyond the float range
+// are refused as the COLMAP readers refuse them: the kernels take them in single precision.
 double to_number(const json& value, const char* key, const Where& where) {
   if (!value.is_number()) where.fail(fmt::format("\"{}\" must be a number", key));
-  return value.get<double>();
+  const double number = value.get<double>();
+  if (!fits_float(number))
+    where.fail(fmt::format("\"{}\" {} is beyond the single-precision range", key, number));
+  return number;
 }
 
 int to_image_side(double side, const char* key, const Where& where) {
@@ -73,7 +77,7 @@ double focal_from_angle(double angle, int side, const char* key, const Where& wh
     where.fail(
         fmt::format("\"{}\" must be a field of view in (0, pi) radians, got {}", key, angle));
   const double focal = 0.5 * side / std::tan(0.5 * angle);
-  if (!std::isfinite(focal)) where.fail(fmt::format("\"{}\" is too small, got {}", key, angle));
+  if (!fits_float(focal)) where.fail(fmt::format("\"{}\" is too small, got {}", key, angle));
   return focal;
 }
 

@@ -375,6 +375,18 @@ TEST(NerfstudioScene, BadInputGivesOneLineErrorNamingFileAndProblem) {
        edited([](json& d) { d["frames"][0]["camera_model"] = 1; }),
        {"frame 0: \"camera_model\" must be a string"}},
       {"k3", edited([](json& d) { d["k3"] = 0.01; }), {"\"k3\" is not supported"}},
+      {"focal beyond float",
+       edited([](json& d) { d["fl_x"] = 1e300; }),
+       {"\"fl_x\" 1e+300 is beyond the single-precision range"}},
+      {"coefficient beyond float",
+       edited([](json& d) { d["frames"][1]["p1"] = -1e308; }),
+       {"frame 1: \"p1\" -1e+308 is beyond the single-precision range"}},
+      {"angle for a focal beyond float",
+       edited([](json& d) {
+         d.erase("fl_x");
+         d["camera_angle_x"] = 1e-300;
+       }),
+       {"\"camera_angle_x\" is too small, got 1e-300"}},
   };
   for (const BadInput& bad : cases) {
     SCOPED_TRACE(bad.what);
