@@ -211,9 +211,14 @@ Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
 
   std::vector<const ColmapImage*> images;
   for (const auto& [id, image] : model.images) images.push_back(&image);
-  // Stable: images of equal names keep their id order, so the split never depends on the sort.
-  std::stable_sort(images.begin(), images.end(),
-                   [](const ColmapImage* a, const ColmapImage* b) { return a->name < b->name; });
+  std::sort(images.begin(), images.end(),
+            [](const ColmapImage* a, const ColmapImage* b) { return a->name < b->name; });
+  // One file posed twice: its copies would fall into both splits, the test views among the
+  // training images.
+  for (size_t i = 1; i < images.size(); ++i)
+    if (images[i]->name == images[i - 1]->name)
+      fail_file(files.images, fmt::format("image '{}' is listed twice (ids {} and {})",
+                                          images[i]->name, images[i - 1]->id, images[i]->id));
 
   Scene scene;
   scene.root = root;

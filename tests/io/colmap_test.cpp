@@ -508,6 +508,11 @@ TEST(Colmap, ImplausibleCamerasAreRefused) {
   write_colmap_model_binary(root / "sparse/0", model);
   expect_error([&] { read_colmap_scene(root.path(), {}); },
                {"images.bin", "'frame_c.jpg': rotation quaternion cannot be normalized"});
+  model = sample_model();
+  model.images[13].name = "frame_a.jpg";  // one file posed twice
+  write_colmap_model_binary(root / "sparse/0", model);
+  expect_error([&] { read_colmap_scene(root.path(), {}); },
+               {"images.bin", "image 'frame_a.jpg' is listed twice"});
 }
 
 TEST(Colmap, MissingFilesAreNamed) {
