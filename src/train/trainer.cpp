@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -236,7 +237,12 @@ void Trainer::require_same_cameras() const {
     fail_file(saved,
               "missing beside the checkpoint, so the views it trained on are unknown: "
               "train without --resume");
-  if (read_file(saved) != cameras_json(train_cameras_))
+  const std::string stored = read_file(saved);
+  if (!nlohmann::json::accept(stored))
+    fail_file(saved,
+              "damaged (not valid JSON), so the views it trained on are unknown: train "
+              "without --resume");
+  if (stored != cameras_json(train_cameras_))
     fail_file(saved,
               "the run trained on other cameras than the scene given now: resume with the same "
               "scene and --downscale");
@@ -334,7 +340,8 @@ void Trainer::fail_diverged(int64_t iteration, double loss) const {
           : std::string("no checkpoint was written yet");
   fail(
       "training diverged at iteration {}: the {} stopped being finite (loss {}); {}. Lower the "
-      "learning rates or check the input images.",
+      "learning rates, or check the input images and the starting model (--init-ply, "
+      "random_extent).",
       iteration, std::isfinite(loss) ? "parameters" : "loss", loss, kept);
 }
 

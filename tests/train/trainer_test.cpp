@@ -289,6 +289,9 @@ TEST_F(TrainerTest, TamperedCheckpointsAreRefused) {
   EXPECT_TRUE(testing::contains(
       resume_error([](gs::GaussianModel& m, Extras&) { m.means.data()[0][0] = NAN; }),
       "holds non-finite parameters"));
+  write_file_atomically(out / "cameras.json", "[{\"id\": 0,");
+  EXPECT_TRUE(testing::contains(error_message([&] { Trainer::resumed(c, setup(out.path())); }),
+                                "cameras.json: damaged (not valid JSON)"));
   std::filesystem::remove(out / "cameras.json");
   EXPECT_TRUE(testing::contains(error_message([&] { Trainer::resumed(c, setup(out.path())); }),
                                 "cameras.json: missing beside the checkpoint"));
