@@ -172,8 +172,10 @@ void add_eval_command(CLI::App& app) {
       ->add_option("ground_truth", args->ground_truth,
                    "Scene (its --split views at --downscale) or a folder of images")
       ->required();
-  command->add_option("-o,--output", args->output,
-                      "Report path without extension (default <renders>/metrics)");
+  command
+      ->add_option("-o,--output", args->output,
+                   "Report path without extension (default <renders>/metrics)")
+      ->check(kNonEmptyPath);
   command->add_option("--split", args->split, "Scene split to compare with")
       ->check(CLI::IsMember({"train", "test"}))
       ->capture_default_str();

@@ -4,6 +4,7 @@
 #include "cli/device_option.hpp"
 #include "cli/external_options.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/validators.hpp"
 #include "io/folder_lock.hpp"
 #include "pipeline/external_stage.hpp"
 
@@ -35,7 +36,9 @@ void add_external_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "external", "External knowledge: super-resolve (and estimate depth of) every training view");
   args->scene.add_to(*command);
-  command->add_option("-o,--output", args->output, "Output folder (image/, depth/)")->required();
+  command->add_option("-o,--output", args->output, "Output folder (image/, depth/)")
+      ->required()
+      ->check(kNonEmptyPath);
   command->add_option("--scale", args->options.scale, "Upscaling factor s")->capture_default_str();
   add_external_options(*command, args->options);
   add_device_option(*command, args->device);

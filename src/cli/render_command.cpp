@@ -134,7 +134,8 @@ void add_render_command(CLI::App& app) {
       ->required();
   args->scene.add_to(*command);
   command->add_option("-o,--output", args->output, "Output folder (rgb/, depth/, alpha/)")
-      ->required();
+      ->required()
+      ->check(kNonEmptyPath);
   command->add_option("--split", args->split, "Which cameras")
       ->check(CLI::IsMember({"train", "test"}))
       ->capture_default_str();

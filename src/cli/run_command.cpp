@@ -125,7 +125,8 @@ CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
   args->scene.add_to(*command);
   pipeline::RunOptions& o = args->options;
   command->add_option("-o,--output", args->output, "Run folder (stages, rows, results)")
-      ->required();
+      ->required()
+      ->check(kNonEmptyPath);
   command->add_option("--scale", o.scale, "Super-resolution factor s")->capture_default_str();
   command->add_flag("--input-is-lr", o.input_is_lr,
                     "The scene's images are the LR input (no HR ground truth: render, no metrics)");

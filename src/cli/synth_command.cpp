@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/validators.hpp"
 #include "core/stopwatch.hpp"
 #include "synth/dataset_writer.hpp"
 
@@ -18,7 +19,9 @@ void add_synth_command(CLI::App& app) {
       "NeRF-Synthetic layout (RGBA PNGs, transforms_train/test.json) or a COLMAP capture");
   auto output = std::make_shared<std::string>();
   auto options = std::make_shared<synth::SynthOptions>();
-  command->add_option("-o,--output", *output, "Directory to write the scene into")->required();
+  command->add_option("-o,--output", *output, "Directory to write the scene into")
+      ->required()
+      ->check(kNonEmptyPath);
   command->add_option("--size", options->size, "Image width and height in pixels")
       ->capture_default_str();
   command

@@ -143,7 +143,9 @@ void add_train_command(CLI::App& app) {
   auto args = std::make_shared<TrainArgs>();
   CLI::App* command = app.add_subcommand("train", "Train a Gaussian-splatting model on a scene");
   args->scene.add_to(*command);
-  command->add_option("-o,--output", args->output, "Output folder")->required();
+  command->add_option("-o,--output", args->output, "Output folder")
+      ->required()
+      ->check(kNonEmptyPath);
   // The options that make up the run's config, which --resume takes from the output folder.
   std::vector<const CLI::Option*> run_options;
   const auto defines_run = [&run_options](CLI::Option* option) {

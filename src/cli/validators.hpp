@@ -32,6 +32,11 @@ inline const CLI::Validator kUnitInterval(
     },
     "IN [0, 1]");
 
+// A path that names something: an empty one would put the outputs in the working folder.
+inline const CLI::Validator kNonEmptyPath(
+    [](std::string& text) -> std::string { return text.empty() ? "must not be empty" : ""; },
+    "PATH");
+
 inline const CLI::Validator kPositive = number_above(0, false, "POSITIVE");
 inline const CLI::Validator kNonNegative = number_above(0, true, "NONNEGATIVE");
 

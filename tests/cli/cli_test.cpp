@@ -62,6 +62,17 @@ TEST(Cli, MissingSceneIsOneLineNamingThePath) {
             "error: " + (dir / "nowhere").string() + ": scene directory not found");
 }
 
+// An empty -o would write into the working folder.
+TEST(Cli, EmptyOutputFolderIsRefused) {
+  for (const char* command : {"synth -o ''", "train scene -o ''", "run scene -o ''"}) {
+    const CliRun run = iesrgs(command);
+    EXPECT_NE(run.status, 0) << command;
+    EXPECT_EQ(last_line(run.output),
+              "error: --output: must not be empty (--help lists the options)")
+        << command;
+  }
+}
+
 TEST(Cli, SynthSceneLoadsAndDecodes) {
   TempDir dir;
   const std::string scene = (dir / "scene").string();
