@@ -18,7 +18,7 @@ struct BenchFrame {
   GaussianCloud cloud;
   std::vector<float> image, alpha, depth, pixel_grad;
   std::vector<int32_t> radii;
-  std::vector<float> dmeans, dscales, dquats, dlogits, dsh_dc, dsh_rest;
+  std::vector<float> dmeans, dscales, dquats, dlogits, dsh_dc, dsh_rest, dview, dview_abs;
   RasterFrame<float> frame;
   const float background[3] = {1, 1, 1};
 
@@ -36,17 +36,21 @@ struct BenchFrame {
     dlogits.resize(n);
     dsh_dc.resize(3 * n);
     dsh_rest.resize(gs::kShRestFloats * n);
+    dview.resize(2 * n);
+    dview_abs.resize(2 * n);
   }
   void forward() {
     rasterize_forward(cloud.params(), camera, background, frame,
                       RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
   }
   void backward() {
-    // The color gradient's first plane doubles as the alpha and depth gradients.
-    rasterize_backward(cloud.params(), frame,
-                       PixelGrads<float>{pixel_grad.data(), pixel_grad.data(), pixel_grad.data()},
-                       GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(),
-                                            dlogits.data(), dsh_dc.data(), dsh_rest.data()});
+    // The color gradient's first plane doubles as the alpha and depth gradients. The viewspace
+    // gradients are asked for as training asks for them, for densification.
+    rasterize_backward(
+        cloud.params(), frame,
+        PixelGrads<float>{pixel_grad.data(), pixel_grad.data(), pixel_grad.data()},
+        GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(), dlogits.data(),
+                             dsh_dc.data(), dsh_rest.data(), dview.data(), dview_abs.data()});
   }
 };
 
