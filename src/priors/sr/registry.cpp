@@ -9,10 +9,10 @@
 #include <regex>
 
 #include "core/error.hpp"
-#include "io/image_tensor.hpp"
 #include "priors/sr/bicubic.hpp"
 #include "priors/sr/esrgan.hpp"
 #include "priors/sr/imdn.hpp"
+#include "priors/sr/network_sr.hpp"
 #include "priors/sr/pan.hpp"
 #include "priors/sr/safmn.hpp"
 #include "priors/sr/sr_net.hpp"
@@ -26,53 +26,15 @@ namespace F = torch::nn::functional;
 
 namespace {
 
-// Weights in channels-last (NHWC) order, oneDNN's native layout: activations then stay
-// channels-last from layer to layer instead of being reordered around every convolution
-// (PAN runs about 25% faster on a CPU; SAFMN and IMDN are unaffected).
-void to_channels_last(torch::nn::Module& module) {
-  for (torch::Tensor& parameter : module.parameters())
-    if (parameter.dim() == 4)
-      parameter.set_data(parameter.contiguous(torch::MemoryFormat::ChannelsLast));
+// Pads by edge replication up to `min_side` pixels a side (SAFMN's smallest input).
+InputPad replicate_to(int64_t min_side) {
+  return [min_side](const torch::Tensor& rgb) {
+    const int64_t pad_y = std::max<int64_t>(0, min_side - rgb.size(2));
+    const int64_t pad_x = std::max<int64_t>(0, min_side - rgb.size(3));
+    if (pad_x == 0 && pad_y == 0) return rgb;
+    return F::pad(rgb, F::PadFuncOptions({0, pad_x, 0, pad_y}).mode(torch::kReplicate));
+  };
 }
-
-// Runs a network module with loaded weights behind the SrNet interface.
-template <class Net>
-class NetworkSr final : public SrNet {
- public:
-  // Inputs with a side below `min_side` are padded by edge replication and cropped back.
-  NetworkSr(std::string name, Net net, int scale, int64_t min_side)
-      : name_(std::move(name)), net_(std::move(net)), scale_(scale), min_side_(min_side) {
-    net_->eval();
-    to_channels_last(*net_);
-  }
-
-  std::string name() const override { return name_; }
-  int scale() const override { return scale_; }
-
-  torch::Tensor upscale(const torch::Tensor& rgb) override {
-    check_rgb_batch(rgb, name_);
-    torch::NoGradGuard no_grad;
-    const int64_t height = rgb.size(2), width = rgb.size(3);
-    const int64_t pad_y = std::max<int64_t>(0, min_side_ - height);
-    const int64_t pad_x = std::max<int64_t>(0, min_side_ - width);
-    const torch::Tensor input =
-        pad_x == 0 && pad_y == 0
-            ? rgb
-            : F::pad(rgb, F::PadFuncOptions({0, pad_x, 0, pad_y}).mode(torch::kReplicate));
-    return on_compute_device(*net_, input, [&](const torch::Tensor& x) {
-      return net_->forward(x.contiguous(torch::MemoryFormat::ChannelsLast))
-          .narrow(2, 0, height * scale_)
-          .narrow(3, 0, width * scale_)
-          .contiguous();
-    });
-  }
-
- private:
-  std::string name_;
-  Net net_;
-  int scale_;
-  int64_t min_side_;
-};
 
 // `weights`, or when empty the model's default checkpoint, which must then exist.
 fs::path checkpoint_file(const std::string& model, int scale, const fs::path& weights) {
@@ -113,7 +75,7 @@ Factory network(const std::string& model, ReleaseCheck check_release = nullptr) 
     options.scale = scale;
     Net net(options);
     load_state_dict(*net, state, file);
-    return std::make_unique<NetworkSr<Net>>(model, std::move(net), scale, 1);
+    return std::make_unique<NetworkSr<Net>>(model, std::move(net), scale);
   };
 }
 
@@ -128,7 +90,7 @@ std::unique_ptr<SrNet> make_safmn(const fs::path& weights, int scale) {
   Safmn net(options);
   load_state_dict(*net, state, file);
   return std::make_unique<NetworkSr<Safmn>>("safmn", std::move(net), scale,
-                                            safmn_min_side(options.release));
+                                            replicate_to(safmn_min_side(options.release)));
 }
 
 const std::map<std::string, Factory>& factories() {

@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "priors/sr/layers.hpp"
+#include "priors/sr/network_sr.hpp"
 
 namespace iesrgs::priors::sr {
 namespace {
@@ -346,7 +347,7 @@ std::unique_ptr<SrNet> load_swinir(StateDict weights, const SwinIRConfig& config
     it = is_derived_mask(it->first) ? weights.erase(it) : std::next(it);
   SwinIR net(config);
   load_state_dict(*net, weights, file);
-  return std::make_unique<SwinIRUpscaler>(std::move(net));
+  return swinir_sr(std::move(net));
 }
 
 // The official classical-SR family: `layers` residual groups of 6 blocks with 6 heads each,
@@ -459,18 +460,15 @@ torch::Tensor SwinIRImpl::reconstruct(const torch::Tensor& features) {
   return conv_last_(torch::nn::functional::leaky_relu(conv_hr_(x), leaky));
 }
 
-SwinIRUpscaler::SwinIRUpscaler(SwinIR net) : net_(std::move(net)) {}
-
-torch::Tensor SwinIRUpscaler::upscale(const torch::Tensor& rgb) {
-  if (rgb.dim() != 4 || rgb.size(1) != 3 || rgb.size(2) == 0 || rgb.size(3) == 0)
-    fail("SwinIR: expected an RGB batch of shape (B, 3, H, W), got {}", c10::str(rgb.sizes()));
-  torch::NoGradGuard no_grad;
-  const int64_t scale = net_->config().scale;
-  return on_compute_device(*net_, rgb.to(torch::kFloat), [&](const torch::Tensor& x) {
-    return net_->forward(mirror_pad_past_window(x, net_->config().window_size))
-        .index({Slice(), Slice(), Slice(0, scale * rgb.size(2)), Slice(0, scale * rgb.size(3))})
-        .contiguous();
-  });
+std::unique_ptr<SrNet> swinir_sr(SwinIR net) {
+  const SwinIRConfig config = net->config();
+  // Not channels-last: the transformer blocks reshape the activations between convolutions.
+  return std::make_unique<NetworkSr<SwinIR>>(
+      "swinir", std::move(net), config.scale,
+      [window = config.window_size](const torch::Tensor& x) {
+        return mirror_pad_past_window(x, window);
+      },
+      /*channels_last=*/false);
 }
 
 std::unique_ptr<SrNet> make_swinir(const std::filesystem::path& weights, int scale) {

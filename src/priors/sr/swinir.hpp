@@ -87,17 +87,7 @@ TORCH_MODULE(SwinIR);
 
 // Runs a SwinIR the way the official test script does: the input is mirrored at the bottom and
 // right up to the next whole window past its size, and the output cropped back.
-class SwinIRUpscaler final : public SrNet {
- public:
-  explicit SwinIRUpscaler(SwinIR net);
-
-  std::string name() const override { return "swinir"; }
-  int scale() const override { return net_->config().scale; }
-  torch::Tensor upscale(const torch::Tensor& rgb) override;
-
- private:
-  SwinIR net_;
-};
+std::unique_ptr<SrNet> swinir_sr(SwinIR net);
 
 // Loads an official SwinIR checkpoint ({"params": ...}), inferring its configuration; `scale`
 // must be the checkpoint's. Throws iesrgs::Error naming the file and the problem.
