@@ -1,11 +1,21 @@
 #pragma once
-// Where the super-resolution backends find their checkpoints (below priors::default_weights_dir),
-// and which backends exist (make_sr_net itself is declared in sr_net.hpp).
+// The super-resolution backends: which exist, how to build one, and where they find their
+// checkpoints (below priors::default_weights_dir).
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "priors/sr/sr_net.hpp"
+
 namespace iesrgs::priors::sr {
+
+// Builds the backend `model` (bicubic, safmn, imdn, pan, swinir, esrgan-slim,
+// esrgan-medium, esrgan-thick) for `scale`, loading `weights` when the model
+// has any (an empty path selects the model's default location, if it has one).
+// Throws iesrgs::Error naming the model or file and the problem.
+std::unique_ptr<SrNet> make_sr_net(const std::string& model, const std::filesystem::path& weights,
+                                   int scale);
 
 // The official file of `model` at `scale`: <weights dir>/sr/<MODEL>_x<scale>.pth, e.g.
 // SAFMN_x4.pth.

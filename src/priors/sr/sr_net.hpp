@@ -3,8 +3,6 @@
 // and `iesrgs upscale` never care which network runs.
 #include <torch/torch.h>
 
-#include <filesystem>
-#include <memory>
 #include <string>
 
 #include "core/device.hpp"
@@ -32,12 +30,5 @@ torch::Tensor on_compute_device(torch::nn::Module& module, const torch::Tensor& 
   module.to(device);
   return forward(input.to(device)).to(torch::kCPU);
 }
-
-// Builds the backend `model` (bicubic, safmn, imdn, pan, swinir, esrgan-slim,
-// esrgan-medium, esrgan-thick) for `scale`, loading `weights` when the model
-// has any (an empty path selects the model's default location, if it has one).
-// Throws iesrgs::Error naming the model or file and the problem.
-std::unique_ptr<SrNet> make_sr_net(const std::string& model, const std::filesystem::path& weights,
-                                   int scale);
 
 }  // namespace iesrgs::priors::sr

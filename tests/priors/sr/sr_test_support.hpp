@@ -12,7 +12,7 @@
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "io/resize.hpp"
-#include "priors/sr/sr_net.hpp"
+#include "priors/sr/registry.hpp"
 #include "priors/state_dict.hpp"
 #include "support/tensor_files.hpp"
 
