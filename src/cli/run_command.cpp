@@ -1,7 +1,6 @@
 // iesrgs run: the whole IE-SRGS pipeline with its baselines (and iesrgs internal / iesrgs fuse,
 // the same options running one stage): external knowledge, internal model and SR-splatting,
 // fusion training of the HR model, rendering and evaluation, each stage cached and resumable.
-#include <fmt/core.h>
 
 #include "cli/commands.hpp"
 #include "cli/device_option.hpp"
@@ -118,8 +117,8 @@ void add_fusion_options(CLI::App& command, RunArgs& args) {
       ->check(kNonNegative);
 }
 
-CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
-                               const std::string& description, pipeline::StageSelection only) {
+void add_pipeline_command(CLI::App& app, const std::string& name, const std::string& description,
+                          pipeline::StageSelection only) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* command = app.add_subcommand(name, description);
   args->scene.add_to(*command);
@@ -144,7 +143,6 @@ CLI::App* add_pipeline_command(CLI::App& app, const std::string& name,
   command->add_option("--seed", args->seed, "Random seed of both trainings")->capture_default_str();
   add_device_option(*command, args->device);
   command->callback([args, only] { run_pipeline(*args, only); });
-  return command;
 }
 
 }  // namespace

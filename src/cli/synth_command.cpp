@@ -1,4 +1,5 @@
-// iesrgs synth: the built-in synthetic scene, written as a NeRF-Synthetic dataset.
+// iesrgs synth: the built-in synthetic scene, written as a NeRF-Synthetic dataset or (--format
+// colmap) as a COLMAP capture.
 #include <fmt/format.h>
 
 #include <map>

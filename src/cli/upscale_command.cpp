@@ -84,8 +84,8 @@ std::vector<Job> jobs_for(const fs::path& input, const fs::path& output) {
 }
 
 // The output tensor, its 8-bit copy and the PNG being encoded: 25 bytes a pixel, measured with
-// bicubic as the growth of the peak resident memory from 4096x4096 to 8192x8192 outputs (the
-// networks add one tile's activations).
+// bicubic as the growth of the peak resident memory from 4096x4096 to 8192x8192 outputs, and a
+// margin for what the networks add (one tile's activations, the input).
 constexpr int64_t kUpscaleBytesPerPixel = 32;
 
 // Refuses, before upscaling, an output larger than any image read here or than the memory.

@@ -1,5 +1,4 @@
 // COLMAP's binary model files: little-endian, uint64 record counts, null-terminated names.
-#include <cmath>
 #include <cstring>
 #include <type_traits>
 #include <utility>

@@ -1,8 +1,6 @@
 // COLMAP's text model files: '#' comment lines, one record per line, except images, which take
 // two lines each (the second lists the 2D points and may be empty).
-#include <algorithm>
 #include <charconv>
-#include <cmath>
 #include <iterator>
 
 #include "core/error.hpp"

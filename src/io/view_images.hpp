@@ -20,7 +20,8 @@ struct ViewImageOptions {
   // Where undistorted images are cached once (the scene folder may be read-only).
   std::filesystem::path undistort_cache_dir = default_cache_dir() / "undistorted";
 
-  static std::filesystem::path default_cache_dir();  // $IESRGS_CACHE_DIR, else ~/.cache/iesrgs
+  // $IESRGS_CACHE_DIR, else $XDG_CACHE_HOME/iesrgs, else ~/.cache/iesrgs, else a temp folder.
+  static std::filesystem::path default_cache_dir();
 };
 
 class ViewImages {

@@ -1,6 +1,5 @@
 #include "pipeline/evaluate.hpp"
 
-#include <fmt/core.h>
 
 #include <optional>
 

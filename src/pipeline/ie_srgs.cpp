@@ -194,9 +194,7 @@ bool Pipeline::row_uses_internal(const RowSpec& row) const {
 }
 
 bool Pipeline::rows_use_internal_references() const {
-  for (const std::string& id : rows_)
-    if (row_uses_internal(row_spec(id))) return true;
-  return false;
+  return any_row([this](const RowSpec& row) { return row_uses_internal(row); });
 }
 
 void Pipeline::check_cached_inputs() const {

@@ -8,7 +8,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 
 #include "io/scene.hpp"
 #include "loss/fusion.hpp"

@@ -61,8 +61,7 @@ InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train
   fmt::print("SR-splatting: rendering {} training views at x{}\n", cameras.size(), scale);
   const Stopwatch watch;
   render_views_to(stage.sr_dir, stage.training.model, cameras, lr_scene.background, scale);
-  stage.sr_seconds = watch.seconds();
-  record_stage(stage.sr_dir, sr, true, stage.sr_seconds);
+  record_stage(stage.sr_dir, sr, true, watch.seconds());  // stage_seconds reads it back
   return stage;
 }
 

@@ -15,7 +15,6 @@ namespace iesrgs::pipeline {
 struct InternalStage {
   StageResult training;
   std::filesystem::path sr_dir;  // <dir>/sr: rgb/<name>.png (I_image), depth/<name>.npy (I_depth)
-  double sr_seconds = 0;         // SR-splatting time (0 when reused)
 };
 
 // Trains in <dir> (cached and resumable, see training_stage.hpp) on lr_scene's training views,

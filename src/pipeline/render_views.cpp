@@ -20,7 +20,7 @@ namespace {
 constexpr float kMinAlphaForDepth = 1e-4f;
 // The rasterizer's planes, the render's tensors and the files' encodings of one view: 56 bytes a
 // pixel, measured on the CPU as the growth of the peak resident memory from 2048x2048 to
-// 4096x4096 renders.
+// 4096x4096 renders, and a margin for the Gaussians' own buffers, which that growth leaves out.
 constexpr int64_t kRenderBytesPerPixel = 64;
 
 // Refuses views too large for the memory of `device` (and of the CPU, which encodes the files)

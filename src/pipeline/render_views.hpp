@@ -10,7 +10,6 @@
 
 #include "gs/model.hpp"
 #include "io/camera.hpp"
-#include "io/image.hpp"
 
 namespace iesrgs::pipeline {
 

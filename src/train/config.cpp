@@ -85,7 +85,6 @@ TrainConfig make_preset(const std::string& name, int64_t iterations) {
     // A third of the paper's schedule keeps densification's rhythm and reaches most of the
     // quality on two cores.
     rescale_schedule(config, 10000);
-    config.test_every = 1000;
   } else if (name == "fast") {
     rescale_schedule(config, 3000);
     config.test_every = 500;

@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <string>
 
-#include "gs/densify.hpp"
 #include "gs/optimizer.hpp"
 #include "loss/photometric.hpp"
 

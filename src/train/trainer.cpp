@@ -10,7 +10,6 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
-#include <fstream>
 #include <limits>
 #include <numeric>
 #include <sstream>
