@@ -1,6 +1,5 @@
 #include "pipeline/evaluate.hpp"
 
-
 #include <optional>
 
 #include "io/image.hpp"

@@ -8,7 +8,6 @@
 #include <string>
 #include <vector>
 
-
 #include "io/scene.hpp"
 #include "loss/fusion.hpp"
 #include "pipeline/external_stage.hpp"
