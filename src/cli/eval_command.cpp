@@ -16,7 +16,6 @@
 #include "io/atomic_file.hpp"
 #include "io/scene.hpp"
 #include "io/view_images.hpp"
-#include "pipeline/evaluate.hpp"
 
 namespace iesrgs::cli {
 
@@ -132,7 +131,7 @@ void run_eval(const EvalArgs& args) {
     const Image reference = truth.get(name);
     try {
       report.views.push_back(
-          pipeline::measure_view(name, render, reference, lpips ? &*lpips : nullptr));
+          eval::measure_view(name, render, reference, lpips ? &*lpips : nullptr));
     } catch (const Error& e) {
       fail_file(files[i], e.what());
     }

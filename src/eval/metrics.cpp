@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "eval/lpips.hpp"
 #include "io/atomic_file.hpp"
 #include "io/image_tensor.hpp"
 #include "loss/ssim.hpp"
@@ -54,6 +55,13 @@ double ssim(const Image& image, const Image& reference) {
   const torch::Tensor x = to_tensor(image), y = to_tensor(reference);  // planar copies
   return loss::ssim<float>(x.data_ptr<float>(), y.data_ptr<float>(), {image.width, image.height, 3},
                            nullptr, nullptr);
+}
+
+ViewMetrics measure_view(const std::string& name, const Image& render, const Image& reference,
+                         const Lpips* lpips) {
+  std::optional<double> perceptual;
+  if (lpips) perceptual = lpips->distance(to_tensor(render), to_tensor(reference));
+  return {name, psnr(render, reference), ssim(render, reference), perceptual};
 }
 
 ViewMetrics MetricsReport::mean() const {

@@ -22,6 +22,12 @@ struct ViewMetrics {
   std::optional<double> lpips;
 };
 
+class Lpips;
+
+// Scores of one render against its reference (both RGB of the same size); LPIPS when given.
+ViewMetrics measure_view(const std::string& name, const Image& render, const Image& reference,
+                         const Lpips* lpips);
+
 struct MetricsReport {
   std::vector<ViewMetrics> views;
   std::string lpips_status;           // "alex", "vgg", or why LPIPS is unavailable

@@ -3,17 +3,9 @@
 #include <optional>
 
 #include "io/image.hpp"
-#include "io/image_tensor.hpp"
 #include "pipeline/render_views.hpp"
 
 namespace iesrgs::pipeline {
-
-eval::ViewMetrics measure_view(const std::string& name, const Image& render, const Image& reference,
-                               const eval::Lpips* lpips) {
-  std::optional<double> perceptual;
-  if (lpips) perceptual = lpips->distance(to_tensor(render), to_tensor(reference));
-  return {name, eval::psnr(render, reference), eval::ssim(render, reference), perceptual};
-}
 
 Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector<Camera>& cameras,
                                const std::array<float, 3>& background, ViewImages* truth,
@@ -26,7 +18,7 @@ Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector
   for (const Camera& camera : cameras) {
     const Image render = to_float(read_image8(rendered_view_files(dir, camera.name).rgb));
     report.views.push_back(
-        measure_view(camera.name, render, *truth->rgb(camera), metric ? &*metric : nullptr));
+        eval::measure_view(camera.name, render, *truth->rgb(camera), metric ? &*metric : nullptr));
   }
   eval::write_report(dir / "metrics", report);
   return evaluation;

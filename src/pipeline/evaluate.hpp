@@ -13,10 +13,6 @@
 
 namespace iesrgs::pipeline {
 
-// Scores of one render against its reference (both RGB of the same size); LPIPS when given.
-eval::ViewMetrics measure_view(const std::string& name, const Image& render, const Image& reference,
-                               const eval::Lpips* lpips);
-
 struct Evaluation {
   eval::MetricsReport report;   // empty without ground truth
   double seconds_per_view = 0;  // rendering alone

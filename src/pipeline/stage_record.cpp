@@ -16,6 +16,38 @@ nlohmann::json read_stage_record(const std::filesystem::path& path) {
   return record.is_object() ? record : nlohmann::json::object();
 }
 
+namespace {
+
+// A record whose fields have other types than record_stage writes was damaged from outside; it
+// counts as none, as an unreadable one does, and the stage trains again.
+nlohmann::json stage_json(const std::filesystem::path& dir) {
+  const nlohmann::json record = read_stage_record(dir / "stage.json");
+  const bool typed = record.value("finished", nlohmann::json(false)).is_boolean() &&
+                     record.value("seconds", nlohmann::json(0.0)).is_number();
+  return typed ? record : nlohmann::json::object();
+}
+
+}  // namespace
+
+bool stage_recorded(const std::filesystem::path& dir, const nlohmann::json& params) {
+  return stage_json(dir).value("params", nlohmann::json()) == params;
+}
+
+bool stage_finished(const std::filesystem::path& dir, const nlohmann::json& params) {
+  const nlohmann::json record = stage_json(dir);
+  return record.value("params", nlohmann::json()) == params && record.value("finished", false);
+}
+
+double stage_seconds(const std::filesystem::path& dir) {
+  return stage_json(dir).value("seconds", 0.0);
+}
+
+void record_stage(const std::filesystem::path& dir, const nlohmann::json& params, bool finished,
+                  double seconds) {
+  const nlohmann::json record = {{"params", params}, {"finished", finished}, {"seconds", seconds}};
+  write_file_atomically(dir / "stage.json", record.dump(2) + "\n");
+}
+
 bool cached_view_intact(const std::filesystem::path& image, const std::filesystem::path& depth,
                         int width, int height) {
   try {

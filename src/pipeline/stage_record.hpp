@@ -15,6 +15,14 @@ namespace iesrgs::pipeline {
 // recomputing the stage.
 nlohmann::json read_stage_record(const std::filesystem::path& path);
 
+// <dir>/stage.json of any stage: written when it starts and on completion, with its parameters
+// and running time. Recorded: started with these parameters, finished or not.
+bool stage_recorded(const std::filesystem::path& dir, const nlohmann::json& params);
+bool stage_finished(const std::filesystem::path& dir, const nlohmann::json& params);
+double stage_seconds(const std::filesystem::path& dir);
+void record_stage(const std::filesystem::path& dir, const nlohmann::json& params, bool finished,
+                  double seconds);
+
 // read(path) for an output a cached stage wrote (outputs are written atomically, so damage comes
 // from outside); its Error then also says how to have the file made again.
 template <typename Read>

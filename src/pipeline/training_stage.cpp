@@ -15,15 +15,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A record whose fields have other types than record_stage writes was damaged from outside; it
-// counts as none, as an unreadable one does, and the stage trains again.
-nlohmann::json stage_json(const fs::path& dir) {
-  const nlohmann::json record = read_stage_record(dir / "stage.json");
-  const bool typed = record.value("finished", nlohmann::json(false)).is_boolean() &&
-                     record.value("seconds", nlohmann::json(0.0)).is_number();
-  return typed ? record : nlohmann::json::object();
-}
-
 // What a training stage's record must match: its inputs and its whole training config.
 nlohmann::json stage_identity(const nlohmann::json& params, const train::TrainConfig& config) {
   return {{"stage", params}, {"training", train::to_json(config)}};
@@ -35,21 +26,6 @@ bool model_finished(const fs::path& dir, const nlohmann::json& identity) {
 }
 
 }  // namespace
-
-bool stage_finished(const fs::path& dir, const nlohmann::json& params) {
-  const nlohmann::json record = stage_json(dir);
-  return record.value("finished", false) && record.value("params", nlohmann::json()) == params;
-}
-
-double stage_seconds(const fs::path& dir) {
-  return stage_json(dir).value("seconds", 0.0);
-}
-
-void record_stage(const fs::path& dir, const nlohmann::json& params, bool finished,
-                  double seconds) {
-  const nlohmann::json record = {{"params", params}, {"finished", finished}, {"seconds", seconds}};
-  write_file_atomically(dir / "stage.json", record.dump(2) + "\n");
-}
 
 StageResult run_training_stage(const std::string& name, const nlohmann::json& params,
                                const train::TrainConfig& config, train::TrainerSetup setup,
@@ -68,8 +44,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   }
   remove_stale_temporaries(dir);  // a killed run's half-written checkpoint, say
   const fs::path checkpoint = train::checkpoint_path(dir);
-  const bool resumable =
-      stage_json(dir).value("params", nlohmann::json()) == identity && fs::exists(checkpoint);
+  const bool resumable = stage_recorded(dir, identity) && fs::exists(checkpoint);
   // An older run's checkpoint would be resumed by the next identical run.
   if (!resumable) train::remove_earlier_run(dir);
   record_stage(dir, identity, false, 0);

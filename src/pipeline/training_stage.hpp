@@ -33,10 +33,4 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
 bool training_stage_current(const std::filesystem::path& dir, const nlohmann::json& params,
                             const train::TrainConfig& config);
 
-// <dir>/stage.json of any stage: written on completion with its parameters and running time.
-bool stage_finished(const std::filesystem::path& dir, const nlohmann::json& params);
-double stage_seconds(const std::filesystem::path& dir);
-void record_stage(const std::filesystem::path& dir, const nlohmann::json& params, bool finished,
-                  double seconds);
-
 }  // namespace iesrgs::pipeline

@@ -18,6 +18,30 @@ std::string train_digest(const Scene& scene) {
   return split_digest(ViewImages(scene), Split::Train);
 }
 
+TEST(StageRecord, FinishedWithTheSameParametersAndItsTime) {
+  TempDir dir;
+  EXPECT_FALSE(stage_finished(dir.path(), {{"a", 1}}));
+  record_stage(dir.path(), {{"a", 1}}, false, 3);
+  EXPECT_TRUE(stage_recorded(dir.path(), {{"a", 1}}));
+  EXPECT_FALSE(stage_finished(dir.path(), {{"a", 1}}));
+  record_stage(dir.path(), {{"a", 1}}, true, 5);
+  EXPECT_TRUE(stage_finished(dir.path(), {{"a", 1}}));
+  EXPECT_FALSE(stage_finished(dir.path(), {{"a", 2}}));
+  EXPECT_EQ(stage_seconds(dir.path()), 5);
+}
+
+// Damaged from outside: the record counts as none and the stage is made again, never a failure.
+TEST(StageRecord, MistypedOrUnreadableRecordCountsAsNone) {
+  TempDir dir;
+  for (const char* damaged :
+       {R"({"params": {}, "finished": "yes", "seconds": 5})",
+        R"({"params": {}, "finished": true, "seconds": "many"})", R"({"params": {}, "fin)"}) {
+    write_file_atomically(dir / "stage.json", damaged);
+    EXPECT_FALSE(stage_finished(dir.path(), nlohmann::json::object())) << damaged;
+    EXPECT_EQ(stage_seconds(dir.path()), 0) << damaged;
+  }
+}
+
 TEST(StageRecord, CachedViewIsIntactOnlyWhenItDecodesAtItsSize) {
   TempDir dir;
   const auto image = dir / "v.png", depth = dir / "v.npy";

@@ -109,20 +109,5 @@ TEST(TrainingStage, DamagedFinishedModelIsWrittenAgain) {
   EXPECT_TRUE(training_stage_current(dir / "stage", {}, run.config));
 }
 
-// A record whose fields have the wrong types counts as none: the stage trains again.
-TEST(TrainingStage, MistypedRecordCountsAsNone) {
-  TempDir dir;
-  const StageRun run = tiny_stage(dir / "scene", dir / "stage");
-  const auto start = [&] { return train::initial_model(run.scene, run.config, {}); };
-  run_training_stage("stage", {}, run.config, run.setup, start);
-  write_file_atomically(dir / "stage" / "stage.json",
-                        R"({"params": {}, "finished": "yes", "seconds": "many"})");
-  EXPECT_FALSE(training_stage_current(dir / "stage", {}, run.config));
-  EXPECT_EQ(stage_seconds(dir / "stage"), 0.0);
-  const StageResult again = run_training_stage("stage", {}, run.config, run.setup, start);
-  EXPECT_FALSE(again.cached);
-  EXPECT_TRUE(training_stage_current(dir / "stage", {}, run.config));
-}
-
 }  // namespace
 }  // namespace iesrgs::pipeline
