@@ -29,6 +29,7 @@
 #include "raster/cpu/dispatch.hpp"
 #include "raster/rasterizer.hpp"
 #include "raster/synthetic_scene.hpp"
+#include "train/session.hpp"
 
 namespace iesrgs::cli {
 
@@ -109,7 +110,8 @@ RasterWorkload synthetic_workload(const RasterBenchArgs& args) {
 
 // A trained model seen from the first training cameras of a scene, as training renders it.
 RasterWorkload trained_workload(const RasterBenchArgs& args) {
-  const gs::GaussianModel model = gs::model_from_splat_cloud(read_model(model_file(args.model)));
+  const gs::GaussianModel model =
+      gs::model_from_splat_cloud(read_model(train::trained_model_file(args.model)));
   SceneOptions options;
   options.downscale = args.downscale;
   const Scene scene = load_scene(args.scene, options);

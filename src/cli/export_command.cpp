@@ -10,6 +10,7 @@
 #include "io/ply.hpp"
 #include "io/splat_file.hpp"
 #include "io/spz_file.hpp"
+#include "train/session.hpp"
 
 namespace iesrgs::cli {
 
@@ -25,7 +26,7 @@ void run_export(const ExportArgs& args) {
   const std::string format = lowercase_extension(output);
   if (format != ".splat" && format != ".spz" && format != ".ply")
     fail_file(output, "unknown export format: the name must end in .splat, .spz or .ply");
-  const std::filesystem::path model = model_file(args.model);
+  const std::filesystem::path model = train::trained_model_file(args.model);
   std::error_code ec;  // set, and false returned, when the output does not exist yet
   // A baked copy over a Mip-Splatting model would lose its 3D filter for good.
   if (std::filesystem::equivalent(model, output, ec))

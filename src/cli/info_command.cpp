@@ -139,7 +139,7 @@ void add_info_command(CLI::App& app) {
         !is_scene(path) && (std::filesystem::exists(train::model_path(path)) ||
                             std::filesystem::exists(train::checkpoint_path(path)));
     if (is_model_file(path) || training_folder) {
-      print_model_summary(model_file(path));
+      print_model_summary(train::trained_model_file(path));
       return;
     }
     if (!is_scene(path) && std::filesystem::is_directory(path / "rows")) {

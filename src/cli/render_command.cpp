@@ -21,6 +21,7 @@
 #include "io/model_file.hpp"
 #include "pipeline/camera_path.hpp"
 #include "pipeline/render_views.hpp"
+#include "train/session.hpp"
 
 namespace iesrgs::cli {
 
@@ -74,7 +75,8 @@ void remove_earlier_views(const std::filesystem::path& dir, const std::vector<st
 void run_render(const RenderArgs& args) {
   use_device(args.device);
   gs::GaussianModel model =
-      gs::model_from_splat_cloud(read_model(model_file(args.model))).to(compute_device());
+      gs::model_from_splat_cloud(read_model(train::trained_model_file(args.model)))
+          .to(compute_device());
   if (args.rasterize_mode != "auto") model.antialiased = args.rasterize_mode == "antialiased";
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   const std::string what = args.path.empty() ? args.split : args.path + " path";

@@ -98,4 +98,16 @@ void remove_earlier_run(const std::filesystem::path& dir) {
   }
 }
 
+std::filesystem::path trained_model_file(const std::filesystem::path& path) {
+  if (!std::filesystem::is_directory(path)) return path;
+  const std::filesystem::path model = model_path(path);
+  if (!std::filesystem::exists(model) && std::filesystem::exists(checkpoint_path(path)))
+    fail_file(path, std::string("its training has not finished (a checkpoint, no "
+                                "point_cloud.ply yet): ") +
+                        (std::filesystem::exists(path / "stage.json")
+                             ? "the iesrgs run, internal or fuse command that made it continues it"
+                             : "the same train command with --resume continues it"));
+  return model;
+}
+
 }  // namespace iesrgs::train

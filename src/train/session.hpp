@@ -49,4 +49,8 @@ void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianMode
 // config, and a render draw the earlier model.
 void remove_earlier_run(const std::filesystem::path& dir);
 
+// A trained model given as its training folder (its point_cloud.ply) or as a model file. Throws
+// Error for a folder whose training has not finished.
+std::filesystem::path trained_model_file(const std::filesystem::path& path);
+
 }  // namespace iesrgs::train
