@@ -405,8 +405,10 @@ torch::Tensor Pipeline::oracle_share(size_t i, const FusionSetup& setup) const {
   const Camera& camera = setup.cameras[i];
   const torch::Tensor truth = train_truth(i, camera);
   if (!truth.defined())
-    fail("view {}: the mask-oracle row needs the HR truth at the HR camera's size, {}x{}",
-         camera.name, camera.intrinsics.width, camera.intrinsics.height);
+    fail_file(hr_scene_ ? hr_scene_->split(Split::Train)[i]->image_path : camera.image_path,
+              fmt::format("the mask-oracle row needs the HR truth of view {} at the HR camera's "
+                          "size, {}x{}",
+                          camera.name, camera.intrinsics.width, camera.intrinsics.height));
   const loss::FusionTargets& targets = setup.targets[i];
   return eval::oracle_mask(targets.internal_image, targets.external_image, truth).to(torch::kFloat);
 }

@@ -41,10 +41,9 @@ fs::path checkpoint_file(const std::string& model, int scale, const fs::path& we
   if (!weights.empty()) return weights;
   const fs::path file = default_sr_weights(model, scale);
   if (!fs::exists(file))
-    fail(
-        "{}: no weights given and the default {} does not exist (pass a checkpoint or set "
-        "IESRGS_WEIGHTS_DIR)",
-        model, file.string());
+    fail_file(file, fmt::format("not found, and {} was given no other checkpoint (pass one, or "
+                                "set IESRGS_WEIGHTS_DIR to the folder above sr/)",
+                                model));
   return file;
 }
 
