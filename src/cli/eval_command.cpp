@@ -11,6 +11,7 @@
 #include "cli/scene_options.hpp"
 #include "cli/validators.hpp"
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "eval/lpips.hpp"
 #include "eval/metrics.hpp"
 #include "io/atomic_file.hpp"
@@ -98,7 +99,7 @@ class GroundTruth {
         fail_file(root_, fmt::format("has no view named \"{}\" in the chosen split", name));
       return *images_->rgb(*found->second);
     }
-    for (const char* ext : {".png", ".jpg", ".jpeg", ".PNG", ".JPG"}) {
+    for (const char* ext : kImageExtensionSpellings) {
       const std::filesystem::path path = root_ / (name + ext);
       if (std::filesystem::exists(path))
         return composite_rgb(read_image8(path), background_.data());

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace iesrgs {
 
@@ -14,6 +15,11 @@ inline std::string lowercase_extension(const std::filesystem::path& path) {
                  [](unsigned char c) { return char(std::tolower(c)); });
   return extension;
 }
+
+// The spellings of the image extensions tried when a name comes without one: file systems tell
+// ".png" from ".PNG", which is_image_file does not.
+inline const std::vector<const char*> kImageExtensionSpellings = {".png", ".jpg", ".jpeg",
+                                                                  ".PNG", ".JPG", ".JPEG"};
 
 // PNG or JPEG by name, the images every reader here decodes.
 inline bool is_image_file(const std::filesystem::path& path) {

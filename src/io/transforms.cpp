@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "io/atomic_file.hpp"
 #include "io/json_file.hpp"
 
@@ -166,7 +167,7 @@ void require_images_exist(const std::vector<Camera>& cameras, const fs::path& js
 // extensions. When none exists: the path as written, with the first extension appended if it has
 // none, for the error to name.
 fs::path frame_image_path(const fs::path& dir, const std::string& file_path,
-                          std::initializer_list<const char*> extensions) {
+                          const std::vector<const char*>& extensions) {
   std::error_code ec;
   const fs::path written = (dir / file_path).lexically_normal();
   if (fs::is_regular_file(written, ec)) return written;
@@ -282,9 +283,9 @@ std::vector<std::pair<std::string, Camera>> nerfstudio_cameras(
   for (size_t i = 0; i < frames.size(); ++i) {
     const FrameKeys keys(document, frames[i], json_path, static_cast<int>(i));
     std::string file_path = read_file_path(frames[i], keys.frame());
-    Camera camera = posed_camera(frames[i], keys.frame(),
-                                 frame_image_path(json_path.parent_path(), file_path,
-                                                  {".png", ".jpg", ".jpeg", ".PNG", ".JPG"}));
+    Camera camera = posed_camera(
+        frames[i], keys.frame(),
+        frame_image_path(json_path.parent_path(), file_path, kImageExtensionSpellings));
     camera.stored = camera.intrinsics = nerfstudio_intrinsics(keys, camera.image_path, read_header);
     camera.distortion = nerfstudio_distortion(keys);
     cameras.emplace_back(std::move(file_path), std::move(camera));
