@@ -35,7 +35,7 @@ struct UpscaleArgs {
   std::string model;
   fs::path weights;
   int scale = 4;
-  priors::sr::TileOptions tiles{256, 32};
+  priors::sr::TileOptions tiles = priors::sr::kDefaultTiles;
   float background = 1.f;
   fs::path input, output;
   std::string device = "auto";

@@ -119,9 +119,8 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
     if (depth) {
       // Depth of E_image as the model saw it: the 8-bit image written above.
       const torch::Tensor seen = to_tensor(to_float(read_image8(view.image)));
-      priors::depth::write_depth_outputs(
-          depth->predict(seen.to(compute_device())).cpu(),
-          {view.image, view.depth, dir / "depth" / (camera.name + "_preview.png")});
+      priors::depth::write_depth_outputs(depth->predict(seen.to(compute_device())).cpu(),
+                                         priors::depth::depth_job(view.image, view.depth));
     }
     record[camera.name] = fingerprint;
     write_file_atomically(record_path, record.dump(1) + "\n");

@@ -17,7 +17,7 @@ struct ExternalOptions {
   std::string sr_model = "auto";     // "auto": see resolve_sr_model
   std::filesystem::path sr_weights;  // empty: the model's default location
   int scale = 4;
-  priors::sr::TileOptions tiles{256, 32};
+  priors::sr::TileOptions tiles = priors::sr::kDefaultTiles;
   std::string depth_model = "none";  // "none" turns the external depth prior off
   std::filesystem::path depth_weights;
 };

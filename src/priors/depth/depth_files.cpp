@@ -14,10 +14,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path preview_path(fs::path npy) {
-  return npy.replace_filename(npy.stem().string() + "_preview.png");
-}
-
 // Two images with one stem (a.png, a.jpg), or an output folder that is the input one, would
 // otherwise overwrite results or inputs without a word.
 void check_names_unique(const std::vector<DepthJob>& jobs) {
@@ -31,17 +27,22 @@ void check_names_unique(const std::vector<DepthJob>& jobs) {
 
 }  // namespace
 
+DepthJob depth_job(const fs::path& image, fs::path npy) {
+  fs::path preview = npy;
+  preview.replace_filename(npy.stem().string() + "_preview.png");
+  return {image, std::move(npy), std::move(preview)};
+}
+
 std::vector<DepthJob> plan_depth_jobs(const fs::path& in, const fs::path& out) {
   std::vector<DepthJob> jobs;
   if (fs::is_directory(in)) {
     for (const fs::path& image : image_files_in(in)) {
-      const fs::path npy = out / image.filename().replace_extension(".npy");
-      jobs.push_back({image, npy, preview_path(npy)});
+      jobs.push_back(depth_job(image, out / image.filename().replace_extension(".npy")));
     }
   } else {
     if (!fs::exists(in)) fail_file(in, "no such image or folder");
     if (out.extension() != ".npy") fail_file(out, "the output of a single image must end in .npy");
-    jobs.push_back({in, out, preview_path(out)});
+    jobs.push_back(depth_job(in, out));
   }
   check_names_unique(jobs);
   return jobs;

@@ -14,6 +14,9 @@ struct DepthJob {
   std::filesystem::path preview;  // depth_preview of them
 };
 
+// The job writing `npy` and "<npy stem>_preview.png" beside it for `image`.
+DepthJob depth_job(const std::filesystem::path& image, std::filesystem::path npy);
+
 // `in` an image file: one job writing `out` (which must end in .npy) and "<out stem>_preview.png"
 // beside it. `in` a folder: one job per PNG or JPEG file directly inside it, by name, writing
 // "<out>/<image stem>.npy" and "<out>/<image stem>_preview.png". Throws Error naming the path

@@ -19,6 +19,10 @@ struct TileOptions {
   int overlap = 32;
 };
 
+// What upscale and the external stage use unless told otherwise: memory bounded at any image
+// size, as 1080x1920 inputs need.
+inline constexpr TileOptions kDefaultTiles{256, 32};
+
 // `net`'s upscale of `rgb` (1, 3, H, W), tile by tile when options.tile is smaller than a side.
 // Throws Error for an overlap that is negative or not smaller than the tile.
 torch::Tensor upscale_tiled(SrNet& net, const torch::Tensor& rgb, const TileOptions& options);
