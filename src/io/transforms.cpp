@@ -319,7 +319,7 @@ std::vector<Camera> parse_blender_transforms(const std::string& text, const fs::
 Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_path,
                                   const SceneOptions& options,
                                   const ImageHeaderReader& read_header) {
-  if (options.test_every < 1) fail("test_every must be at least 1, got {}", options.test_every);
+  if (options.test_every < 1) fail("--test-every must be at least 1, got {}", options.test_every);
   std::vector<std::pair<std::string, Camera>> cameras =
       nerfstudio_cameras(parse_object(text, json_path), json_path, read_header);
   // The split must not depend on the order frames happen to be listed in.
