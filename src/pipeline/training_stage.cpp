@@ -2,6 +2,8 @@
 
 #include <fmt/core.h>
 
+#include <optional>
+
 #include "core/error.hpp"
 #include "core/progress.hpp"
 #include "io/atomic_file.hpp"
@@ -48,19 +50,28 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   // An older run's checkpoint would be resumed by the next identical run.
   if (!resumable) train::remove_earlier_run(dir);
   record_stage(dir, identity, false, 0);
-  if (resumable) fmt::print("{}: resuming from {}\n", name, checkpoint.string());
-  train::Trainer trainer = resumable ? train::Trainer::resumed(config, std::move(setup))
-                                     : train::Trainer(config, std::move(setup), initial_model());
-  const train::TrainSummary summary = trainer.run();
+  std::optional<train::Trainer> trainer;
+  if (resumable) {
+    fmt::print("{}: resuming from {}\n", name, checkpoint.string());
+    try {
+      trainer.emplace(train::Trainer::resumed(config, setup));
+    } catch (const Error& e) {
+      // A checkpoint this stage cannot continue (damaged, or not its own) would stop every rerun.
+      fmt::print("{}: {}; training it again from the start\n", name, e.what());
+      train::remove_earlier_run(dir);
+    }
+  }
+  if (!trainer) trainer.emplace(config, std::move(setup), initial_model());
+  const train::TrainSummary summary = trainer->run();
   if (summary.interrupted)
     throw Interrupted(
         fmt::format("{} stopped at iteration {}; run the same command again to resume", name,
                     summary.iterations));
-  train::write_point_clouds(dir, trainer.model());
+  train::write_point_clouds(dir, trainer->model());
   record_stage(dir, identity, true, summary.seconds);
   fmt::print("{}: {} Gaussians after {} ({:.2f} it/s)\n", name, summary.gaussians,
              format_duration(summary.seconds), summary.iterations_per_second);
-  return {trainer.model(), summary.seconds, false};
+  return {trainer->model(), summary.seconds, false};
 }
 
 bool training_stage_current(const fs::path& dir, const nlohmann::json& params,

@@ -211,8 +211,8 @@ void Trainer::restore_extras(gs::CheckpointExtras& extras) {
                                 fmt::join(setup_.background, ",")));
   const double iteration = stored("iteration");
   if (!(iteration >= 0 && iteration <= double(config_.iterations)))
-    fail_file(path, fmt::format("stored at iteration {}, outside the run's 0..{} (resume with the "
-                                "run's own --iterations)",
+    fail_file(path, fmt::format("stored at iteration {}, outside the 0..{} iterations of the run's "
+                                "config.json",
                                 iteration, config_.iterations));
   iteration_ = int64_t(iteration);
   seconds_before_ = stored("seconds");
@@ -234,13 +234,13 @@ void Trainer::require_same_cameras() const {
   // Training writes it before its first checkpoint: a checkpoint without it came from elsewhere.
   if (!std::filesystem::exists(saved))
     fail_file(saved,
-              "missing beside the checkpoint, so the views it trained on are unknown: "
-              "train without --resume");
+              "missing beside the checkpoint, so the views it trained on are unknown (start "
+              "the training over)");
   const std::string stored = read_file(saved);
   if (!nlohmann::json::accept(stored))
     fail_file(saved,
-              "damaged (not valid JSON), so the views it trained on are unknown: train "
-              "without --resume");
+              "damaged (not valid JSON), so the views it trained on are unknown (start the "
+              "training over)");
   if (stored != cameras_json(train_cameras_))
     fail_file(saved,
               "the run trained on other cameras than the scene given now: resume with the same "

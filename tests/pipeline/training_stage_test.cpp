@@ -85,6 +85,31 @@ TEST(TrainingStage, InterruptedStageResumesFromItsCheckpoint) {
   EXPECT_TRUE(training_stage_current(dir / "stage", {}, run.config));
 }
 
+// A checkpoint the stage cannot continue (here: its cameras.json is gone) is not resumed on every
+// rerun in vain: the stage trains again from the start.
+TEST(TrainingStage, UnresumableCheckpointTrainsTheStageAgain) {
+  TempDir dir;
+  StageRun run = tiny_stage(dir / "scene", dir / "stage");
+  run.config.iterations = 12;
+  int steps = 0;
+  run.setup.loss = [&](int view, const raster::RenderOutput& render) {
+    if (++steps == 5) std::raise(SIGINT);
+    return (render.image - run.setup.train_views[size_t(view)].target).abs().mean();
+  };
+  const auto start = [&] { return train::initial_model(run.scene, run.config, {}); };
+  EXPECT_THROW(run_training_stage("stage", {}, run.config, run.setup, start), Interrupted);
+  std::filesystem::remove(dir / "stage" / "cameras.json");
+  int starts = 0;
+  const auto counted_start = [&] {
+    ++starts;
+    return start();
+  };
+  const StageResult again = run_training_stage("stage", {}, run.config, run.setup, counted_start);
+  EXPECT_EQ(starts, 1);
+  EXPECT_FALSE(again.cached);
+  EXPECT_TRUE(training_stage_current(dir / "stage", {}, run.config));
+}
+
 // A finished model damaged since it was written comes back from the final checkpoint, without
 // training; with the checkpoint gone too, the stage trains again.
 TEST(TrainingStage, DamagedFinishedModelIsWrittenAgain) {

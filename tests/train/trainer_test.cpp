@@ -275,7 +275,7 @@ TEST_F(TrainerTest, TamperedCheckpointsAreRefused) {
   using Extras = gs::CheckpointExtras;
   EXPECT_TRUE(testing::contains(
       resume_error([](auto&, Extras& e) { e["iteration"] = torch::tensor(int64_t(5)); }),
-      "stored at iteration 5, outside the run's 0..4"));
+      "stored at iteration 5, outside the 0..4 iterations"));
   EXPECT_TRUE(testing::contains(resume_error([](auto&, Extras& e) {
                                   e["iteration"] = torch::tensor({1, 2});
                                 }),
@@ -295,6 +295,32 @@ TEST_F(TrainerTest, TamperedCheckpointsAreRefused) {
   std::filesystem::remove(out / "cameras.json");
   EXPECT_TRUE(testing::contains(error_message([&] { Trainer::resumed(c, setup(out.path())); }),
                                 "cameras.json: missing beside the checkpoint"));
+}
+
+// Checkpoints of older versions hold only the required extras; they resume as before.
+TEST_F(TrainerTest, CheckpointWithoutTheOptionalExtrasResumes) {
+  TempDir out;
+  TrainConfig c = config();
+  c.iterations = 6;
+  c.checkpoint_every = 3;
+  TrainerSetup s = setup(out.path());
+  const std::vector<TrainView> views = s.train_views;
+  int calls = 0;
+  s.loss = [&](int view, const raster::RenderOutput& render) {
+    if (++calls == 3 * 3) std::raise(SIGINT);  // checkpoints after iteration 3
+    return loss::photometric_autograd(render.image, views[size_t(view)].target, 0.2);
+  };
+  ASSERT_TRUE(Trainer(c, s, initial()).run().interrupted);
+  const std::filesystem::path file = out / "checkpoint.pt";
+  gs::GaussianModel model;
+  gs::GaussianOptimizer optimizer(initial(), {}, 1);
+  gs::DensifyStats stats;
+  gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}}};
+  gs::load_training_state(file, model, optimizer, stats, &extras);
+  gs::save_training_state(file, model, optimizer, stats, extras);  // without seconds, loss, ...
+  const TrainSummary resumed = Trainer::resumed(c, setup(out.path())).run();
+  EXPECT_FALSE(resumed.interrupted);
+  EXPECT_EQ(resumed.iterations, 6);
 }
 
 TEST_F(TrainerTest, EmptyStartingPlyIsAClearError) {
