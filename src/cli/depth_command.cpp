@@ -70,7 +70,8 @@ void add_depth_command(CLI::App& app) {
   command
       ->add_option("OUT", args->out,
                    "For an image: the .npy to write; for a folder: the folder to write into")
-      ->required();
+      ->required()
+      ->check(kNonEmptyPath);
   add_device_option(*command, args->device);
   command->callback([args] { run_depth(*args); });
 }

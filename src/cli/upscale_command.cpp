@@ -155,7 +155,9 @@ void add_upscale_command(CLI::App& app) {
       ->capture_default_str()
       ->check(kUnitInterval);
   command->add_option("input", args->input, "Image or folder of images")->required();
-  command->add_option("output", args->output, "PNG file, or folder for a folder input")->required();
+  command->add_option("output", args->output, "PNG file, or folder for a folder input")
+      ->required()
+      ->check(kNonEmptyPath);
   add_device_option(*command, args->device);
   command->callback([args] { run(*args); });
 }

@@ -23,18 +23,18 @@ constexpr float kMinAlphaForDepth = 1e-4f;
 // 4096x4096 renders, and a margin for the Gaussians' own buffers, which that growth leaves out.
 constexpr int64_t kRenderBytesPerPixel = 64;
 
-// Refuses views too large for the memory of `device` (and of the CPU, which encodes the files)
-// before rendering any: the kernel would kill the process partway through.
-void require_render_memory(const std::vector<Camera>& cameras, double scale, torch::Device device) {
+// Refuses views too large for the memory before rendering any: the kernel would kill the process
+// partway through. The CPU's alone, which holds every view's outputs and encodes the files: on a
+// GPU the free memory leaves out what LibTorch has cached, and running out there is an error
+// LibTorch reports.
+void require_render_memory(const std::vector<Camera>& cameras, double scale) {
   Intrinsics largest;
   for (const Camera& camera : cameras) {
     const Intrinsics size = camera.scaled(scale).intrinsics;
     if (int64_t(size.width) * size.height > int64_t(largest.width) * largest.height) largest = size;
   }
-  const int64_t bytes = int64_t(largest.width) * largest.height * kRenderBytesPerPixel;
-  const std::string what = fmt::format("rendering {}x{} views", largest.width, largest.height);
-  require_memory(bytes, what);
-  if (!device.is_cpu()) require_memory(bytes, what, device);
+  require_memory(int64_t(largest.width) * largest.height * kRenderBytesPerPixel,
+                 fmt::format("rendering {}x{} views", largest.width, largest.height));
 }
 
 std::vector<float> to_vector(const torch::Tensor& tensor) {
@@ -88,7 +88,7 @@ void write_rendered_view(const std::filesystem::path& dir, const std::string& na
 double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,
                        const std::vector<Camera>& cameras, const std::array<float, 3>& background,
                        double scale) {
-  require_render_memory(cameras, scale, model.means.device());
+  require_render_memory(cameras, scale);
   // One untimed frame first: a process's first render pays for loading the GPU kernels and
   // growing the allocator's pools, which would otherwise count against the rendering speed.
   if (!cameras.empty()) render_view(model, cameras.front().scaled(scale), background);

@@ -4,10 +4,12 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <tuple>
 
+#include "core/memory.hpp"
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "io/ply.hpp"
@@ -64,12 +66,19 @@ TEST(Cli, MissingSceneIsOneLineNamingThePath) {
 
 // An empty -o would write into the working folder.
 TEST(Cli, EmptyOutputFolderIsRefused) {
-  for (const char* command : {"synth -o ''", "train scene -o ''", "run scene -o ''"}) {
+  for (const char* command :
+       {"synth -o ''", "train scene -o ''", "run scene -o ''", "render model scene -o ''",
+        "external scene -o ''", "eval renders scene -o ''"}) {
     const CliRun run = iesrgs(command);
     EXPECT_NE(run.status, 0) << command;
     EXPECT_EQ(last_line(run.output),
               "error: --output: must not be empty (--help lists the options)")
         << command;
+  }
+  for (const char* command : {"upscale --model bicubic a.png ''", "depth a.png ''"}) {
+    const CliRun run = iesrgs(command);
+    EXPECT_NE(run.status, 0) << command;
+    EXPECT_TRUE(contains(last_line(run.output), "must not be empty")) << command << run.output;
   }
 }
 
@@ -212,17 +221,23 @@ TEST(Cli, UpscaleNeverWritesOverItsInputNorPngBytesUnderAnotherName) {
 TEST(Cli, UpscaleRefusesAnOutputTooLargeBeforeUpscaling) {
   TempDir dir;
   const std::string image = (dir / "a.png").string(), output = (dir / "out.png").string();
-  write_png(image, Image8(6, 4, 3));
+  write_png(image, Image8(60, 40, 3));
   const CliRun huge = iesrgs("upscale --model bicubic --scale 2000000000 " + image + " " + output);
   EXPECT_EQ(huge.status, 1);
   EXPECT_EQ(last_line(huge.output),
             "error: " + image +
-                ": upscaled, it would be 12000000000x8000000000 pixels (at most 65536 a side)");
-  // 65532x43688 fits a PNG, but not the memory of the machines this runs on (85 GiB).
-  const CliRun big = iesrgs("upscale --model bicubic --scale 10922 " + image + " " + output);
-  EXPECT_EQ(big.status, 1);
-  EXPECT_TRUE(contains(last_line(big.output), "not enough memory: upscaling " + image))
-      << big.output;
+                ": upscaled, it would be 120000000000x80000000000 pixels (at most 65536 a side)");
+  // An output that fits a PNG but needs about twice the available memory (32 bytes a pixel;
+  // sized from this host's memory, when it is under 2 TiB).
+  const int64_t available = available_memory_bytes();
+  const int scale = int(std::ceil(std::sqrt(2.0 * double(available) / (60 * 40 * 32))));
+  if (available > 0 && 60 * scale <= 65536) {
+    const CliRun big = iesrgs("upscale --model bicubic --scale " + std::to_string(scale) + " " +
+                              image + " " + output);
+    EXPECT_EQ(big.status, 1);
+    EXPECT_TRUE(contains(last_line(big.output), "not enough memory: upscaling " + image))
+        << big.output;
+  }
   EXPECT_FALSE(std::filesystem::exists(output));
 }
 
