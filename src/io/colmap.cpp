@@ -211,8 +211,9 @@ Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
 
   std::vector<const ColmapImage*> images;
   for (const auto& [id, image] : model.images) images.push_back(&image);
-  std::sort(images.begin(), images.end(),
-            [](const ColmapImage* a, const ColmapImage* b) { return a->name < b->name; });
+  // Stable: equal names keep their id order, which the error below names.
+  std::stable_sort(images.begin(), images.end(),
+                   [](const ColmapImage* a, const ColmapImage* b) { return a->name < b->name; });
   // One file posed twice: its copies would fall into both splits, the test views among the
   // training images.
   for (size_t i = 1; i < images.size(); ++i)

@@ -17,7 +17,12 @@ MappedFile::MappedFile(const std::filesystem::path& path) {
   if (fd < 0)
     fail_file(path, std::string("cannot open for reading (") + std::strerror(errno) + ")");
   struct stat info {};
-  if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+  if (::fstat(fd, &info) != 0) {
+    const int error = errno;
+    ::close(fd);
+    fail_file(path, std::string("cannot read its size (") + std::strerror(error) + ")");
+  }
+  if (!S_ISREG(info.st_mode)) {
     ::close(fd);
     fail_file(path, "not a regular file");
   }

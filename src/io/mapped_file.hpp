@@ -1,6 +1,8 @@
 #pragma once
 // A file mapped read-only into memory: its pages are read on demand and belong to the page cache,
-// so checking a large file needs no copy of it on the heap.
+// so checking a large file needs no copy of it on the heap. The price: a read error of the disk,
+// or another process truncating the file while it is mapped, ends the process (SIGBUS) where a
+// read would report an error. Outputs here are replaced by renaming, never truncated.
 #include <filesystem>
 #include <string_view>
 

@@ -512,7 +512,7 @@ TEST(Colmap, ImplausibleCamerasAreRefused) {
   model.images[13].name = "frame_a.jpg";  // one file posed twice
   write_colmap_model_binary(root / "sparse/0", model);
   expect_error([&] { read_colmap_scene(root.path(), {}); },
-               {"images.bin", "image 'frame_a.jpg' is listed twice"});
+               {"images.bin", "image 'frame_a.jpg' is listed twice (ids 11 and 13)"});
 }
 
 TEST(Colmap, MissingFilesAreNamed) {
