@@ -2,11 +2,27 @@
 // File name helpers shared by the commands and readers.
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace iesrgs {
+
+// The path an environment variable holds; none when it is unset or empty.
+inline std::optional<std::filesystem::path> env_path(const char* variable) {
+  const char* value = std::getenv(variable);
+  if (value == nullptr || *value == '\0') return std::nullopt;
+  return std::filesystem::path(value);
+}
+
+// The XDG cache folder of `app`: $XDG_CACHE_HOME/<app>, else ~/.cache/<app>; none without either.
+inline std::optional<std::filesystem::path> user_cache_dir(const std::string& app) {
+  if (auto cache = env_path("XDG_CACHE_HOME")) return *cache / app;
+  if (auto home = env_path("HOME")) return *home / ".cache" / app;
+  return std::nullopt;
+}
 
 // ".png" for "a.PNG": file types are told apart by extension in any case.
 inline std::string lowercase_extension(const std::filesystem::path& path) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "priors/state_dict.hpp"
 
 namespace iesrgs::eval {
@@ -69,17 +70,10 @@ const NetSpec& spec(LpipsNet net) {
   return net == LpipsNet::Alex ? kAlex : kVgg;
 }
 
-std::optional<fs::path> env_path(const char* variable) {
-  const char* value = std::getenv(variable);
-  if (value == nullptr || *value == '\0') return std::nullopt;
-  return fs::path(value);
-}
-
 // torch.hub's cache root, where torchvision downloads its checkpoints.
 fs::path torch_home() {
   if (auto home = env_path("TORCH_HOME")) return *home;
-  if (auto cache = env_path("XDG_CACHE_HOME")) return *cache / "torch";
-  return env_path("HOME").value_or(fs::path()) / ".cache" / "torch";
+  return user_cache_dir("torch").value_or(fs::path(".cache") / "torch");
 }
 
 bool is_file(const fs::path& path) {

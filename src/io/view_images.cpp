@@ -6,6 +6,7 @@
 #include <iterator>
 
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "io/file_digest.hpp"
 #include "io/resize.hpp"
 #include "io/undistort.hpp"
@@ -59,11 +60,8 @@ std::string size_origin(const Scene& scene, const Camera& camera) {
 }  // namespace
 
 fs::path ViewImageOptions::default_cache_dir() {
-  if (const char* dir = std::getenv("IESRGS_CACHE_DIR"); dir && *dir) return dir;
-  if (const char* dir = std::getenv("XDG_CACHE_HOME"); dir && *dir) return fs::path(dir) / "iesrgs";
-  if (const char* home = std::getenv("HOME"); home && *home)
-    return fs::path(home) / ".cache" / "iesrgs";
-  return fs::temp_directory_path() / "iesrgs-cache";
+  if (auto dir = env_path("IESRGS_CACHE_DIR")) return *dir;
+  return user_cache_dir("iesrgs").value_or(fs::temp_directory_path() / "iesrgs-cache");
 }
 
 ViewImages::ViewImages(const Scene& scene, ViewImageOptions options)

@@ -9,6 +9,7 @@
 
 #include "core/byte_reader.hpp"
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "io/atomic_file.hpp"
 #include "io/zip_archive.hpp"
 #include "priors/pickle.hpp"
@@ -16,8 +17,7 @@
 namespace iesrgs::priors {
 
 std::filesystem::path default_weights_dir() {
-  if (const char* dir = std::getenv("IESRGS_WEIGHTS_DIR"); dir && *dir) return dir;
-  return IESRGS_DEV_WEIGHTS_DIR;
+  return env_path("IESRGS_WEIGHTS_DIR").value_or(IESRGS_DEV_WEIGHTS_DIR);
 }
 
 namespace {

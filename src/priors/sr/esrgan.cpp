@@ -8,6 +8,7 @@
 #include <iterator>
 
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "io/image_tensor.hpp"
 #include "priors/keras_model.hpp"
 
@@ -60,8 +61,7 @@ class Esrgan final : public SrNet {
 };
 
 fs::path npm_dir() {
-  const char* dir = std::getenv("IESRGS_NPM_DIR");
-  return dir && *dir ? fs::path(dir) : fs::path(IESRGS_DEFAULT_NPM_DIR);
+  return env_path("IESRGS_NPM_DIR").value_or(IESRGS_DEFAULT_NPM_DIR);
 }
 
 // The npm command spelled out, since setup installs only kSetupEsrganVariants; the loader was
