@@ -3,7 +3,6 @@
 #include <torch/serialize.h>
 
 #include <fstream>
-#include <memory>
 #include <string>
 
 #include "core/byte_reader.hpp"
@@ -86,15 +85,19 @@ void save_training_state(const std::filesystem::path& path, const GaussianModel&
 void load_training_state(const std::filesystem::path& path, GaussianModel& model,
                          GaussianOptimizer& optimizer, DensifyStats& stats,
                          CheckpointExtras* extras) {
-  // Checked through a mapping, then read by LibTorch from the file: a copy of the whole file
-  // beside the tensors loaded from it set the peak memory of a resume.
-  auto file = std::make_unique<MappedFile>(path);
+  // Checked and read through one mapping, so that the bytes loaded are the bytes checked even if
+  // the file is replaced meanwhile. The pages are dropped once read, as a copy of the whole file
+  // beside the tensors loaded from it would set the peak memory of a resume.
+  const MappedFile file(path);
   try {
     // LibTorch's reader skips the CRCs, so damaged bytes would load as a different model.
-    ZipArchive(file->bytes()).check_all();
-    file.reset();
+    ZipArchive(file.bytes()).check_all();
+    file.drop_pages(0, file.bytes().size());
     torch::serialize::InputArchive archive;
-    archive.load_from(path.string(), torch::kCPU);  // wherever it was trained
+    archive.load_from([&file](uint64_t offset, void* out,
+                              size_t size) { return file.read_through(offset, out, size); },
+                      [&file] { return file.bytes().size(); },
+                      torch::kCPU);  // wherever it was trained
     GaussianModel loaded_model = load_model(archive);
     GaussianOptimizer loaded_optimizer = optimizer;
     loaded_optimizer.load_state(archive, loaded_model);

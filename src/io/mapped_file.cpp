@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -37,6 +38,21 @@ MappedFile::MappedFile(const std::filesystem::path& path) {
   } else {
     ::close(fd);
   }
+}
+
+size_t MappedFile::read_through(size_t offset, void* out, size_t size) const {
+  offset = std::min(offset, size_);
+  size = std::min(size, size_ - offset);
+  if (size > 0) std::memcpy(out, data_ + offset, size);
+  drop_pages(offset, size);
+  return size;
+}
+
+void MappedFile::drop_pages(size_t offset, size_t size) const {
+  static const size_t page = size_t(::sysconf(_SC_PAGESIZE));
+  const size_t first = (offset + page - 1) / page * page, end = (offset + size) / page * page;
+  // Advice only: pages it leaves in place cost memory, not correctness.
+  if (end > first) ::madvise(const_cast<char*>(data_) + first, end - first, MADV_DONTNEED);
 }
 
 MappedFile::~MappedFile() {

@@ -18,6 +18,15 @@ class MappedFile {
 
   std::string_view bytes() const { return {data_, size_}; }
 
+  // Copies up to `size` bytes from `offset` into `out` (fewer at the end of the file; returns how
+  // many), then drops the pages it read whole from this process's resident memory: read through
+  // once, a large file costs the page cache, not the process's memory. Touched again, pages are
+  // read again.
+  size_t read_through(size_t offset, void* out, size_t size) const;
+
+  // Drops the pages lying whole within the range from this process's resident memory.
+  void drop_pages(size_t offset, size_t size) const;
+
  private:
   const char* data_ = nullptr;
   size_t size_ = 0;

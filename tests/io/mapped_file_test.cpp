@@ -23,6 +23,24 @@ TEST(MappedFile, ViewsTheFileBytes) {
   EXPECT_EQ(file.bytes(), bytes);
 }
 
+TEST(MappedFile, ReadsThroughAcrossDroppedPagesAndStopsAtTheEnd) {
+  TempDir dir;
+  std::string bytes(3 * 4096 + 100, '\0');
+  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i * 7 % 251);
+  write_text(dir / "a.bin", bytes);
+  const MappedFile file(dir / "a.bin");
+  file.drop_pages(0, bytes.size());  // read again from the file when touched
+  std::string copy(bytes.size(), '\0');
+  size_t offset = 0;
+  while (offset < bytes.size()) offset += file.read_through(offset, copy.data() + offset, 1000);
+  EXPECT_EQ(copy, bytes);
+  char tail[8];
+  EXPECT_EQ(file.read_through(bytes.size() - 3, tail, sizeof tail), 3u);
+  EXPECT_EQ(std::string(tail, 3), bytes.substr(bytes.size() - 3));
+  EXPECT_EQ(file.read_through(bytes.size() + 5, tail, sizeof tail), 0u);
+  EXPECT_EQ(file.bytes(), bytes);
+}
+
 TEST(MappedFile, EmptyFileIsAnEmptyView) {
   TempDir dir;
   write_text(dir / "empty", "");
