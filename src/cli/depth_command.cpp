@@ -5,7 +5,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
-#include "cli/device_option.hpp"
+#include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
@@ -61,11 +61,7 @@ void add_depth_command(CLI::App& app) {
       ->add_option("--weights", args->weights,
                    "The authors' checkpoint, depth_anything_v2_<vits|vitb|vitl>.pth")
       ->required();
-  command
-      ->add_option("--background", args->background,
-                   "Gray level in [0, 1] that transparent pixels are composited over")
-      ->check(kUnitInterval)
-      ->capture_default_str();
+  add_gray_background_option(*command, args->background);
   command->add_option("IN", args->in, "An image, or a folder of images")->required();
   command
       ->add_option("OUT", args->out,

@@ -9,6 +9,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "core/paths.hpp"
@@ -185,12 +186,7 @@ void add_eval_command(CLI::App& app) {
   command
       ->add_option("--background", args->background, "Background for RGBA renders and ground truth")
       ->capture_default_str();
-  command
-      ->add_option("--lpips", args->lpips,
-                   "LPIPS backbone (torchvision checkpoint in $IESRGS_WEIGHTS_DIR or "
-                   "~/.cache/torch/hub/checkpoints)")
-      ->check(CLI::IsMember({"alex", "vgg", "none"}))
-      ->capture_default_str();
+  add_lpips_option(*command, args->lpips);
   command->callback([args] { run_eval(*args); });
 }
 

@@ -1,9 +1,9 @@
 // iesrgs external: stage 1 of IE-SRGS alone (2D super-resolution and monocular depth of every
 // training view), cached and resumable.
 #include "cli/commands.hpp"
-#include "cli/device_option.hpp"
 #include "cli/external_options.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
 #include "io/folder_lock.hpp"
 #include "pipeline/external_stage.hpp"

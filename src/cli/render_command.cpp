@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
-#include "cli/device_option.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"

@@ -3,9 +3,9 @@
 // fusion training of the HR model, rendering and evaluation, each stage cached and resumable.
 
 #include "cli/commands.hpp"
-#include "cli/device_option.hpp"
 #include "cli/external_options.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
 #include "pipeline/ie_srgs.hpp"
 #include "pipeline/rows.hpp"
@@ -107,9 +107,7 @@ void add_fusion_options(CLI::App& command, RunArgs& args) {
                   "Comparison rows, comma-separated: " + pipeline::describe_rows())
       ->delimiter(',')
       ->capture_default_str();
-  command.add_option("--lpips", o.lpips, "LPIPS backbone: alex, vgg or none")
-      ->check(CLI::IsMember({"alex", "vgg", "none"}))
-      ->capture_default_str();
+  add_lpips_option(command, o.lpips);
   command
       .add_option("--diagnostic-views", o.diagnostic_views,
                   "Training views in the diagnostics contact sheet")

@@ -8,8 +8,8 @@
 #include <optional>
 
 #include "cli/commands.hpp"
-#include "cli/device_option.hpp"
 #include "cli/scene_options.hpp"
+#include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "core/memory.hpp"

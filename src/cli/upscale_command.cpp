@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "cli/device_option.hpp"
+#include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "core/memory.hpp"
@@ -149,11 +149,7 @@ void add_upscale_command(CLI::App& app) {
                    "Input pixels shared by neighbouring tiles, cross-faded")
       ->capture_default_str()
       ->check(kNonNegative);
-  command
-      ->add_option("--background", args->background,
-                   "Gray level in [0, 1] that transparent pixels are composited over")
-      ->capture_default_str()
-      ->check(kUnitInterval);
+  add_gray_background_option(*command, args->background);
   command->add_option("input", args->input, "Image or folder of images")->required();
   command->add_option("output", args->output, "PNG file, or folder for a folder input")
       ->required()

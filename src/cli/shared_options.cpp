@@ -1,0 +1,42 @@
+#include "cli/shared_options.hpp"
+
+#include <fmt/core.h>
+
+#include "cli/validators.hpp"
+#include "core/device.hpp"
+
+namespace iesrgs::cli {
+
+void add_device_option(CLI::App& command, std::string& device) {
+  command
+      .add_option(
+          "--device", device,
+          "Run on the cpu, on a cuda GPU, or auto: the GPU when this build and machine have "
+          "one")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
+      ->capture_default_str();
+}
+
+void add_lpips_option(CLI::App& command, std::string& backbone) {
+  command
+      .add_option("--lpips", backbone,
+                  "LPIPS backbone: alex, vgg or none (torchvision's checkpoint, looked up in "
+                  "$IESRGS_WEIGHTS_DIR, else in torchvision's download cache)")
+      ->check(CLI::IsMember({"alex", "vgg", "none"}))
+      ->capture_default_str();
+}
+
+void add_gray_background_option(CLI::App& command, float& gray) {
+  command
+      .add_option("--background", gray,
+                  "Gray level in [0, 1] that transparent pixels are composited over")
+      ->check(kUnitInterval)
+      ->capture_default_str();
+}
+
+void use_device(const std::string& device) {
+  set_compute_device(parse_device(device));
+  fmt::print("device: {}\n", describe_device(compute_device()));
+}
+
+}  // namespace iesrgs::cli

@@ -1,0 +1,24 @@
+#pragma once
+// Options that several commands share, each with one help text and one check.
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace iesrgs::cli {
+
+// Adds --device cpu|cuda|auto (default auto) to `command`, stored in `device`: where the tensors
+// and the kernels of the commands that compute (train, render, the networks) run.
+void add_device_option(CLI::App& command, std::string& device);
+
+// Adds --lpips alex|vgg|none, the LPIPS backbone of the evaluations, stored in `backbone`.
+void add_lpips_option(CLI::App& command, std::string& backbone);
+
+// Adds --background, the gray level in [0, 1] that the networks' commands composite transparent
+// pixels over, stored in `gray`.
+void add_gray_background_option(CLI::App& command, float& gray);
+
+// Makes `device` this process's compute device (core/device.hpp) and says which it is. Throws
+// Error when it names a GPU this build or machine cannot use.
+void use_device(const std::string& device);
+
+}  // namespace iesrgs::cli
