@@ -202,7 +202,9 @@ IESRGS_HD Splat<T> make_splat(const GaussianParams<T>& g, int i, const RasterCam
 template <typename T>
 struct SplatBounds {
   T x0, y0, x1, y1;  // pixels [x0, x1) x [y0, y1), clamped to the image
-  T radius;          // reported for densification: the larger half-extent of the box
+  // Reported for densification: the larger half-extent of the box. Being the extent where alpha
+  // reaches 1/255, not 3DGS's 3 sigma, it is smaller for faint splats, which max_screen_size sees.
+  T radius;
 };
 
 // Bounding box of the pixels whose alpha can reach 1/255. Unlike 3DGS's fixed 3 sigma this drops
@@ -219,7 +221,8 @@ IESRGS_HD void splat_bounds(const Splat<T>& s, const Sym2<T>& filtered, int widt
   b.y0 = clamp(hd::ceil(s.y - hy - T(0.5)), height);
   b.x1 = clamp(hd::floor(s.x + hx - T(0.5)) + T(1), width);
   b.y1 = clamp(hd::floor(s.y + hy - T(0.5)) + T(1), height);
-  b.radius = hd::ceil(hd::max(hx, hy));
+  // Capped so that a diverged but finite extent still converts to an int (splat_rect).
+  b.radius = hd::min(hd::ceil(hd::max(hx, hy)), T(1 << 30));
   // A diverged Gaussian (non-finite center or extent) covers nothing instead of every pixel.
   const auto finite = [](T v) { return T(-INFINITY) < v && v < T(INFINITY); };
   const auto seen = T(0) < s.cutoff && finite(s.x + hx) && finite(s.y + hy);

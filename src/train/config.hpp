@@ -30,7 +30,7 @@ struct TrainConfig {
   // Large-splat pruning after the first opacity reset; 0: off. 3DGS and Mip-Splatting pass a
   // 20-pixel limit too, but zero the radii it tests before testing them: only the world-size
   // rule prunes there, so that is the default.
-  float max_screen_size = 0;          // pixels
+  float max_screen_size = 0;          // pixels, of the extent where alpha reaches 1/255
   double max_world_size = 0.1;        // x the scene extent
   int64_t filter_update_every = 100;  // Mip-Splatting 3D filter, once densification has stopped
   // Densification grows the model no further than this (largest gradients first); 0: no cap

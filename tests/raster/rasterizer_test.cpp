@@ -303,6 +303,17 @@ TEST(RasterForward, DivergedGaussiansCoverNothing) {
   for (int i = healthy.count(); i < mixed.count(); ++i) EXPECT_EQ(r.radii[size_t(i)], 0) << i;
 }
 
+TEST(RasterForward, HugeFiniteGaussianKeepsAPositiveRadius) {
+  // Extents beyond an int's range: densification's visibility (radius > 0) and its max screen
+  // size pruning must still see the splat.
+  const Camera cam = test_camera(16, 16);
+  Scene<double> scene;
+  scene.add({0, 0, 3}, {25, 25, 25}, {1, 0, 0, 0}, 2, {1, 0, 0}, 0);
+  const float bg[3] = {0, 0, 0};
+  const KernelRender<float> r = kernel_render(scene.cast<float>(), cam, bg);
+  EXPECT_EQ(r.radii[0], 1 << 30);
+}
+
 TEST(RasterForward, EmptySceneShowsBackground) {
   const Camera cam = test_camera(20, 17);
   const KernelRender<float> r =
