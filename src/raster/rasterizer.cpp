@@ -57,9 +57,23 @@ void validate_inputs(const GaussianParams<T>& g, const RasterCamera<T>& cam) {
 }
 
 template <typename T>
+void validate_targets(const RenderTargets<T>& out, int count) {
+  if (!(out.image && out.alpha && out.depth && (out.radii || count == 0)))
+    fail("rasterizer: every render target (image, alpha, depth, radii) is required");
+}
+
+template <typename T>
+void validate_grads(const GaussianGrads<T>& grads, int count) {
+  if (count > 0 && !(grads.means && grads.log_scales && grads.quats && grads.opacity_logits &&
+                     grads.sh_dc && grads.sh_rest))
+    fail("rasterizer: a parameter gradient array is missing");
+}
+
+template <typename T>
 void rasterize_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
                        const T background[3], RasterFrame<T>& frame, const RenderTargets<T>& out) {
   validate_inputs(g, cam);
+  validate_targets(out, g.count);
   frame.camera = cam;
   std::copy_n(background, 3, frame.background);
   frame.splats.resize(g.count);
@@ -80,6 +94,7 @@ void rasterize_backward(const GaussianParams<T>& g, RasterFrame<T>& frame,
   if (size_t(g.count) != frame.splats.size())
     fail("rasterizer: backward got {} Gaussians, forward rendered {}", g.count,
          frame.splats.size());
+  validate_grads(grads, g.count);
   StageTimer timer;
   cpu::blend_backward(frame, pixel_grads.image, pixel_grads.alpha, pixel_grads.depth);
   frame.timings.blend_backward = timer.lap();
@@ -91,6 +106,10 @@ template RasterCamera<float> raster_camera(const Camera&);
 template RasterCamera<double> raster_camera(const Camera&);
 template void validate_inputs(const GaussianParams<float>&, const RasterCamera<float>&);
 template void validate_inputs(const GaussianParams<double>&, const RasterCamera<double>&);
+template void validate_targets(const RenderTargets<float>&, int);
+template void validate_targets(const RenderTargets<double>&, int);
+template void validate_grads(const GaussianGrads<float>&, int);
+template void validate_grads(const GaussianGrads<double>&, int);
 template void rasterize_forward(const GaussianParams<float>&, const RasterCamera<float>&,
                                 const float[3], RasterFrame<float>&, const RenderTargets<float>&);
 template void rasterize_forward(const GaussianParams<double>&, const RasterCamera<double>&,

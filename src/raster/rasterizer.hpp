@@ -63,8 +63,16 @@ RasterCamera<T> raster_camera(const Camera& camera);
 template <typename T>
 void validate_inputs(const GaussianParams<T>& g, const RasterCamera<T>& cam);
 
+// Throws Error unless every target is given (radii may be null when there are no Gaussians).
+template <typename T>
+void validate_targets(const RenderTargets<T>& out, int count);
+
+// Throws Error unless every parameter gradient array is given (the viewspace ones may be null).
+template <typename T>
+void validate_grads(const GaussianGrads<T>& grads, int count);
+
 // Renders g seen by cam over background; frame keeps what the backward pass needs.
-// Throws Error on invalid sizes or SH degree.
+// Throws Error on invalid sizes or SH degree, or a missing target.
 template <typename T>
 void rasterize_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
                        const T background[3], RasterFrame<T>& frame, const RenderTargets<T>& out);

@@ -265,6 +265,16 @@ TEST(RasterForward, RejectsInvalidInput) {
   s.sh_degree = 4;
   EXPECT_THROW(kernel_render(s, cam, bg), Error);
   s.sh_degree = 3;
+  KernelRender<float> r = kernel_render(s, cam, bg);
+  EXPECT_THROW(rasterize_forward(
+                   s.params(), raster_camera<float>(cam), bg, r.frame,
+                   RenderTargets<float>{r.image.data(), r.alpha.data(), r.depth.data(), nullptr}),
+               Error);
+  std::vector<float> grads(size_t(s.count()) * 64);
+  float* d = grads.data();
+  EXPECT_THROW(rasterize_backward(s.params(), r.frame, PixelGrads<float>{},
+                                  GaussianGrads<float>{d, d, d, nullptr, d, d, nullptr, nullptr}),
+               Error);
   cam.intrinsics.width = 0;
   EXPECT_THROW(kernel_render(s, cam, bg), Error);
 }

@@ -85,8 +85,7 @@ Rasterizer::~Rasterizer() = default;
 void Rasterizer::forward(const GaussianParams<float>& g, const RasterCamera<float>& cam,
                          const float background[3], const RenderTargets<float>& out) {
   validate_inputs(g, cam);
-  if (!(out.image && out.alpha && out.depth && (out.radii || g.count == 0)))
-    fail("CUDA rasterizer: every render target (image, alpha, depth, radii) is required");
+  validate_targets(out, g.count);
   State& s = *state_;
   s.camera = cam;
   s.count = g.count;
@@ -112,9 +111,7 @@ void Rasterizer::backward(const GaussianParams<float>& g, const PixelGrads<float
   State& s = *state_;
   if (g.count != s.count)
     fail("rasterizer: backward got {} Gaussians, forward rendered {}", g.count, s.count);
-  if (g.count > 0 && !(grads.means && grads.log_scales && grads.quats && grads.opacity_logits &&
-                       grads.sh_dc && grads.sh_rest))
-    fail("CUDA rasterizer: a parameter gradient array is missing");
+  validate_grads(grads, g.count);
   const size_t n = size_t(g.count);
   for (const GradArray<float>& a : grad_arrays(grads, n))
     if (a.data) check(cudaMemsetAsync(a.data, 0, a.size * sizeof(float), s.stream), "cudaMemset");

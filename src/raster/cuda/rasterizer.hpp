@@ -35,7 +35,7 @@ class Rasterizer {
   Rasterizer(const Rasterizer&) = delete;
   Rasterizer& operator=(const Rasterizer&) = delete;
 
-  // As raster::rasterize_forward; out.radii is required.
+  // As raster::rasterize_forward.
   void forward(const GaussianParams<float>& g, const RasterCamera<float>& cam,
                const float background[3], const RenderTargets<float>& out);
   // As raster::rasterize_backward, for the latest forward call with the same g.
