@@ -30,6 +30,18 @@ torch::Tensor external_depth_loss(const raster::RenderOutput& render,
   return 1 - pearson_autograd(inverse_depth, disparity, covered);
 }
 
+// The shape of the two images the discrepancy compares, checked as its kernel reads them: float32
+// (C, H, W) images in host memory, of one shape.
+ImageShape host_image_pair(const torch::Tensor& internal, const torch::Tensor& external) {
+  for (const torch::Tensor& image : {internal, external})
+    if (!image.defined() || !image.device().is_cpu() || image.scalar_type() != torch::kFloat)
+      fail("fusion: the discrepancy takes float32 images in host memory");
+  if (internal.sizes() != external.sizes())
+    fail("fusion: the internal image's shape {} differs from the external image's {}",
+         c10::str(internal.sizes()), c10::str(external.sizes()));
+  return chw_shape(internal, "fusion");
+}
+
 }  // namespace
 
 FusionTargets FusionTargets::to(torch::Device device) const {
@@ -55,9 +67,9 @@ const char* texture_guidance_name(TextureGuidance guidance) {
 
 torch::Tensor discrepancy(const torch::Tensor& internal_image,
                           const torch::Tensor& external_image) {
+  const ImageShape shape = host_image_pair(internal_image, external_image);
   const torch::Tensor internal = internal_image.contiguous(),
                       external = external_image.contiguous();
-  const ImageShape shape = chw_shape(internal, "fusion");
   return map_tensor(discrepancy_map(internal.data_ptr<float>(), external.data_ptr<float>(), shape),
                     shape, torch::kFloat);
 }
@@ -69,9 +81,9 @@ torch::Tensor internal_share(TextureGuidance guidance, const torch::Tensor& inte
   const int64_t height = reference.size(1), width = reference.size(2);
   switch (guidance) {
     case TextureGuidance::Masked: {
+      const ImageShape shape = host_image_pair(internal_image, external_image);
       const torch::Tensor internal = internal_image.contiguous();
       const torch::Tensor external = external_image.contiguous();
-      const ImageShape shape = chw_shape(internal, "fusion");
       return map_tensor(discrepancy_mask(internal.data_ptr<float>(), external.data_ptr<float>(),
                                          shape, threshold),
                         shape, torch::kUInt8);

@@ -116,6 +116,16 @@ TEST(FusionLoss, InternalDepthTermIsZeroWhereNothingIsCovered) {
   EXPECT_EQ(render.depth.grad().abs().sum().item<double>(), 0);
 }
 
+TEST(FusionLoss, DiscrepancyRefusesImagesItCannotCompare) {
+  const torch::Tensor internal = random_image(3);
+  const std::string smaller = testing::error_message(
+      [&] { discrepancy(internal, internal.narrow(2, 0, kWidth - 1).contiguous()); });
+  EXPECT_TRUE(testing::contains(smaller, "differs from the external image's")) << smaller;
+  EXPECT_THROW(internal_share(TextureGuidance::Masked, internal, internal.to(torch::kDouble), 0.5),
+               Error);
+  EXPECT_THROW(internal_share(TextureGuidance::Masked, internal, torch::Tensor(), 0.5), Error);
+}
+
 TEST(FusionLoss, MissingReferenceOrUnknownGuidanceIsAnError) {
   EXPECT_THROW(parse_texture_guidance("mixed"), Error);
   EXPECT_EQ(parse_texture_guidance("average"), TextureGuidance::Average);
