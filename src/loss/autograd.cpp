@@ -131,7 +131,7 @@ class PearsonFunction : public torch::autograd::Function<PearsonFunction> {
   static at::Tensor forward(AutogradContext* ctx, const at::Tensor& a_in, const at::Tensor& b_in,
                             const at::Tensor& mask_in) {
     const at::Tensor a = a_in.contiguous(), b = b_in.contiguous();
-    const at::Tensor mask = mask_in.to(at::kByte).contiguous();
+    const at::Tensor mask = (mask_in != 0).to(at::kByte).contiguous();
     const double correlation = with_scalar_type(a, [&](auto zero) {
       using T = decltype(zero);
       return pearson_correlation<T>(a.data_ptr<T>(), b.data_ptr<T>(), mask.data_ptr<uint8_t>(),

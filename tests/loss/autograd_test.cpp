@@ -226,8 +226,10 @@ TEST(PearsonAutograd, TensorOpsMatchTheKernel) {
   at::Tensor one = torch::zeros({21, 16}, torch::kBool);
   one[3][5] = true;
   // A constant side and a single entry leave the correlation undefined: 0, with a zero gradient.
+  // A fractional mask selects every nonzero entry, on either path.
   const std::vector<std::pair<at::Tensor, at::Tensor>> cases = {
       {a, some},
+      {a, some.to(at::kFloat) * 0.5},
       {a, torch::ones({21, 16}, torch::kBool)},
       {torch::full({21, 16}, 2.f), some},
       {a, one}};
