@@ -17,13 +17,12 @@ namespace iesrgs::gs {
 
 namespace {
 
-const char* const kModelKeys[kParamCount] = {"model/means",      "model/sh_dc",
-                                             "model/sh_rest",    "model/opacity_logits",
-                                             "model/log_scales", "model/quats"};
+std::string model_key(int p) {
+  return std::string("model/") + param_name(Param(p));
+}
 
 void save_model(torch::serialize::OutputArchive& archive, const GaussianModel& model) {
-  for (int p = 0; p < kParamCount; ++p)
-    archive.write(kModelKeys[p], model.param(Param(p)).detach());
+  for (int p = 0; p < kParamCount; ++p) archive.write(model_key(p), model.param(Param(p)).detach());
   archive.write("model/active_sh_degree", torch::tensor(int64_t(model.active_sh_degree)));
   if (model.filter_3d.defined()) archive.write("model/filter_3d", model.filter_3d);
 }
@@ -33,9 +32,11 @@ void check_model(const GaussianModel& model) {
   const std::vector<int64_t> expected[kParamCount] = {
       {n, 3}, {n, 1, 3}, {n, kShCoefficients - 1, 3}, {n}, {n, 3}, {n, 4}};
   for (int p = 0; p < kParamCount; ++p)
-    if (model.param(Param(p)).sizes() != c10::IntArrayRef(expected[p]) ||
-        model.param(Param(p)).scalar_type() != torch::kFloat32)
-      fail("{} has shape {}", kModelKeys[p], c10::str(model.param(Param(p)).sizes()));
+    if (model.param(Param(p)).sizes() != c10::IntArrayRef(expected[p]))
+      fail("{} has shape {}", model_key(p), c10::str(model.param(Param(p)).sizes()));
+    else if (model.param(Param(p)).scalar_type() != torch::kFloat32)
+      fail("{} holds {}, not float32", model_key(p),
+           c10::toString(model.param(Param(p)).scalar_type()));
   if (model.filter_3d.defined() && model.filter_3d.sizes() != c10::IntArrayRef{n})
     fail("model/filter_3d has shape {}", c10::str(model.filter_3d.sizes()));
   if (model.active_sh_degree < 0 || model.active_sh_degree > kMaxShDegree)
@@ -45,7 +46,7 @@ void check_model(const GaussianModel& model) {
 GaussianModel load_model(torch::serialize::InputArchive& archive) {
   GaussianModel model;
   std::array<torch::Tensor, kParamCount> params;
-  for (int p = 0; p < kParamCount; ++p) archive.read(kModelKeys[p], params[p]);
+  for (int p = 0; p < kParamCount; ++p) archive.read(model_key(p), params[p]);
   model.set_params(params);
   torch::Tensor degree;
   archive.read("model/active_sh_degree", degree);

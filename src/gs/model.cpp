@@ -61,6 +61,12 @@ void check_cloud(const SplatCloud& cloud) {
 
 }  // namespace
 
+const char* param_name(Param p) {
+  static const char* const kNames[kParamCount] = {"means",          "sh_dc",      "sh_rest",
+                                                  "opacity_logits", "log_scales", "quats"};
+  return kNames[int(p)];
+}
+
 torch::Tensor& GaussianModel::param(Param p) {
   return const_cast<torch::Tensor&>(static_cast<const GaussianModel&>(*this).param(p));
 }

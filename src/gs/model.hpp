@@ -18,6 +18,9 @@ namespace iesrgs::gs {
 enum class Param { Means, ShDc, ShRest, OpacityLogits, LogScales, Quats };
 constexpr int kParamCount = 6;
 
+// The parameter's name as GaussianModel's member, which checkpoints and messages use.
+const char* param_name(Param p);
+
 struct GaussianModel {
   torch::Tensor means;           // (N, 3)
   torch::Tensor sh_dc;           // (N, 1, 3)

@@ -14,9 +14,6 @@ namespace iesrgs::gs {
 
 namespace {
 
-const char* const kParamNames[kParamCount] = {"means",          "sh_dc",      "sh_rest",
-                                              "opacity_logits", "log_scales", "quats"};
-
 void adam_update(float* param, const float* grad, float* first, float* second, int64_t count,
                  float step_size, float bias2_sqrt) {
 #pragma omp parallel for simd schedule(static)
@@ -80,12 +77,14 @@ void GaussianOptimizer::step(GaussianModel& model) {
   for (int p = 0; p < kParamCount; ++p) {
     torch::Tensor& param = model.param(Param(p));
     const torch::Tensor& grad = param.grad();
-    if (!grad.defined()) fail("optimizer step: {} has no gradient", kParamNames[p]);
-    if (grad.sizes() != moments_[p].first.sizes() || !param.is_contiguous())
-      fail("optimizer step: {} has shape {} but its moments {}", kParamNames[p],
+    if (!grad.defined()) fail("optimizer step: {} has no gradient", param_name(Param(p)));
+    if (grad.sizes() != moments_[p].first.sizes())
+      fail("optimizer step: {} has shape {} but its moments {}", param_name(Param(p)),
            c10::str(grad.sizes()), c10::str(moments_[p].first.sizes()));
+    if (!param.is_contiguous())  // updated in place through its data pointer
+      fail("optimizer step: {} is not contiguous", param_name(Param(p)));
     if (param.device() != moments_[p].first.device())
-      fail("optimizer step: {} is on {}, its moments on {}", kParamNames[p],
+      fail("optimizer step: {} is on {}, its moments on {}", param_name(Param(p)),
            c10::str(param.device()), c10::str(moments_[p].first.device()));
     const torch::Tensor g = grad.contiguous();
     const auto update = param.is_cuda() ? device_adam_update : adam_update;
@@ -127,8 +126,8 @@ void GaussianOptimizer::reset_moments(Param p) {
 void GaussianOptimizer::save_state(torch::serialize::OutputArchive& archive) const {
   archive.write("adam/steps", torch::tensor(steps_, torch::kInt64));
   for (int p = 0; p < kParamCount; ++p) {
-    archive.write(std::string("adam/first/") + kParamNames[p], moments_[p].first);
-    archive.write(std::string("adam/second/") + kParamNames[p], moments_[p].second);
+    archive.write(std::string("adam/first/") + param_name(Param(p)), moments_[p].first);
+    archive.write(std::string("adam/second/") + param_name(Param(p)), moments_[p].second);
   }
 }
 
@@ -138,13 +137,13 @@ void GaussianOptimizer::load_state(torch::serialize::InputArchive& archive,
   archive.read("adam/steps", steps);
   std::array<AdamMoments, kParamCount> loaded;
   for (int p = 0; p < kParamCount; ++p) {
-    archive.read(std::string("adam/first/") + kParamNames[p], loaded[p].first);
-    archive.read(std::string("adam/second/") + kParamNames[p], loaded[p].second);
+    archive.read(std::string("adam/first/") + param_name(Param(p)), loaded[p].first);
+    archive.read(std::string("adam/second/") + param_name(Param(p)), loaded[p].second);
     const auto shape = model.param(Param(p)).sizes();
     if (loaded[p].first.sizes() != shape || loaded[p].second.sizes() != shape ||
         loaded[p].first.scalar_type() != torch::kFloat32 ||
         loaded[p].second.scalar_type() != torch::kFloat32)
-      fail("optimizer state: {} moments do not match the model's shape {}", kParamNames[p],
+      fail("optimizer state: {} moments do not match the model's shape {}", param_name(Param(p)),
            c10::str(shape));
   }
   if (steps.numel() != 1 || steps.scalar_type() != torch::kInt64 || steps.item<int64_t>() < 0)

@@ -68,8 +68,8 @@ double ssim_in(const T* x, const T* y, const ImageShape& shape, const std::vecto
                T* map, T* partials);
 
 // ssim_backward() for the pixels of disjoint boxes only, which must hold every pixel within the
-// window's radius of a nonzero weight. Partials are read (times a zero weight) around the pixels
-// ssim_in computed, so the buffer must hold finite values there, zeros say.
+// window's radius of a nonzero weight. Partials are read only where the weight is nonzero, so the
+// buffer may hold anything around the pixels ssim_in computed.
 template <typename T>
 void ssim_backward_in(const T* x, const T* y, const ImageShape& shape,
                       const std::vector<PixelBox>& boxes, const T* partials, const T* weight,

@@ -40,8 +40,8 @@ struct RasterFrame {
   std::vector<Splat<T>> splats;  // (N)
   std::vector<PixelRect> rects;  // (N), empty for culled Gaussians
   TileBins bins;
-  std::vector<T> final_transmittance;     // (H * W)
-  std::vector<uint32_t> contributors;     // (H * W) entries of its tile blended into the pixel
+  std::vector<T> final_transmittance;  // (H * W)
+  std::vector<uint32_t> contributors;  // (H * W) entries of its tile up to its last blended splat
   std::vector<SplatGrad<T>> entry_grads;  // (entries), by slot
   std::vector<SplatGrad<T>> splat_grads;  // (N)
   RasterTimings timings;
