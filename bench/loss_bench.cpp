@@ -7,6 +7,7 @@
 
 #include <torch/torch.h>
 
+#include "core/math.hpp"
 #include "loss/autograd.hpp"
 #include "loss/benchmark_image.hpp"
 #include "loss/photometric.hpp"
@@ -72,10 +73,10 @@ std::vector<float> outline_mask(const ImageShape& shape) {
     const double cx = side * (0.3 + 0.4 * ((circle * 7) % 12) / 11.0);
     const double cy = side * (0.3 + 0.4 * ((circle * 5) % 12) / 11.0);
     const double radius = side * (0.05 + 0.15 * ((circle * 3) % 12) / 11.0);
-    const int points = int(2 * M_PI * radius);
+    const int points = int(2 * kPi * radius);
     for (int k = 0; k < points; k += 4) {
-      const int x = int(cx + radius * std::cos(2 * M_PI * k / points));
-      const int y = int(cy + radius * std::sin(2 * M_PI * k / points));
+      const int x = int(cx + radius * std::cos(2 * kPi * k / points));
+      const int y = int(cy + radius * std::sin(2 * kPi * k / points));
       if (x >= 0 && x < shape.width && y >= 0 && y < shape.height)
         mask[size_t(y) * shape.width + x] = 1.f;
     }

@@ -5,14 +5,13 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "gs/mip_filter.hpp"
 
 namespace iesrgs::gs {
 
 namespace {
 
-constexpr double kNearPlane = 0.2;
 constexpr double kFrameMargin = 0.15;  // fraction of the image size on each side
-constexpr double kFilterVariance = 0.2;
 
 // Camera z of `mean` if the camera sees it, infinity otherwise.
 double visible_depth(const Camera& camera, const Vec3& mean) {
@@ -45,7 +44,7 @@ std::vector<float> filter3d_std(const float* means, int count, const std::vector
   std::vector<float> std_dev(depth.size());
   for (size_t i = 0; i < depth.size(); ++i) {
     const double d = std::isfinite(depth[i]) ? depth[i] : farthest_seen;
-    std_dev[i] = float(d / focal * std::sqrt(kFilterVariance));
+    std_dev[i] = float(filter3d_std_at(d, focal));
   }
   return std_dev;
 }

@@ -5,9 +5,23 @@
 // unchanged. 2D mip filter: the screen-space covariance gets kMipFilterVariance on its diagonal
 // and the opacity the matching factor. Models trained without it (3DGS, most .spz files) are
 // drawn with 3DGS's dilation instead, as they were trained: more variance, opacity unchanged.
+#include <cmath>
+
 #include "core/geometry.hpp"
 
 namespace iesrgs::gs {
+
+// Gaussians at camera z at or below this are culled, as 3DGS does; the 3D filter counts the
+// cameras that see a Gaussian beyond it.
+constexpr double kNearPlane = 0.2;
+// Variance in pixels^2, at the sampling rate of the closest camera that sees a Gaussian, of the
+// 3D smoothing filter.
+constexpr double kFilter3dVariance = 0.2;
+
+// The 3D filter's std for a Gaussian at camera depth `depth` of a camera of focal length `focal`.
+inline double filter3d_std_at(double depth, double focal) {
+  return depth / focal * std::sqrt(kFilter3dVariance);
+}
 
 // Variance in pixels^2 of the screen-space box-filter approximation.
 constexpr double kMipFilterVariance = 0.1;

@@ -11,7 +11,6 @@
 
 namespace iesrgs::raster {
 
-constexpr double kNearPlane = 0.2;  // Gaussians with camera z at or below are culled, as 3DGS
 // The Jacobian is taken no further out than this fraction of the image's half-width (height)
 // beyond each edge: 3DGS's 1.3 x tan(fov / 2) for a centred principal point.
 constexpr double kJacobianMargin = 0.3;
@@ -119,7 +118,7 @@ IESRGS_HD hd::Mask<T> project(const GaussianRow<T>& g, const RasterCamera<T>& ca
   const Mat3T<T> w = camera_rotation(cam);
   p.view = mul(w, g.mean) + Vec3T<T>{cam.translation[0], cam.translation[1], cam.translation[2]};
   const T z = p.view.z;
-  hd::Mask<T> visible = z > T(kNearPlane);  // also culls a non-finite mean
+  hd::Mask<T> visible = z > T(gs::kNearPlane);  // also culls a non-finite mean
 
   for (int k = 0; k < 3; ++k) p.scale[k] = hd::exp(g.log_scale[k]);
   p.opacity3d = gs::filter3d(p.scale, g.filter_std, p.var);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include "gs/mip_filter.hpp"
 #include "gs/sh.hpp"
 
 namespace iesrgs::raster {
@@ -45,8 +46,7 @@ GaussianCloud synthetic_scene(int count, const RasterCamera<float>& cam, uint32_
     for (int k = 0; k < gs::kShCoefficients; ++k)
       for (int ch = 0; ch < 3; ++ch)
         (k == 0 ? c.sh_dc : c.sh_rest).push_back((k == 0 ? 0.8f : 0.05f) * normal(rng));
-    // Mip-Splatting's filter for this one camera: z / f * sqrt(0.2).
-    c.filter_std.push_back(z / cam.fx * std::sqrt(0.2f));
+    c.filter_std.push_back(float(gs::filter3d_std_at(z, cam.fx)));  // for this one camera
   }
   return c;
 }
