@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <iterator>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/paths.hpp"
@@ -65,15 +66,20 @@ fs::path npm_dir() {
 }
 
 // The npm command spelled out, since setup installs only kSetupEsrganVariants; the loader was
-// checked against the 1.0.0 packages.
+// checked against the 1.0.0 packages. It names setup's packages too: npm removes the unsaved
+// packages that a later install does not name.
 std::string install_hint(const std::string& variant, bool default_location) {
   const std::string name = "esrgan-" + variant;
   if (!default_location) return fmt::format("the folder is not an @upscalerjs/{} package", name);
+  std::vector<std::string> packages;
+  for (const char* installed : kSetupEsrganVariants)
+    packages.push_back(fmt::format("@upscalerjs/esrgan-{}@1.0.0", installed));
   const bool from_setup =
       std::find(std::begin(kSetupEsrganVariants), std::end(kSetupEsrganVariants), variant) !=
       std::end(kSetupEsrganVariants);
-  return fmt::format("npm install --prefix {} @upscalerjs/{}@1.0.0 installs it{}",
-                     npm_dir().string(), name, from_setup ? ", and so does scripts/setup.sh" : "");
+  if (!from_setup) packages.push_back(fmt::format("@upscalerjs/{}@1.0.0", name));
+  return fmt::format("npm install --prefix {} --no-save {} installs it{}", npm_dir().string(),
+                     fmt::join(packages, " "), from_setup ? ", and so does scripts/setup.sh" : "");
 }
 
 }  // namespace
