@@ -49,12 +49,21 @@ bool inside_folder(const std::string& name) {
   return std::none_of(path.begin(), path.end(), [](const auto& part) { return part == ".."; });
 }
 
-// The views an earlier render listed in the folder's render.json that this one, of the views
-// `names`, does not make (fewer path frames, another split): they would mix with its own. Only
-// files that render wrote, and none outside the folder whatever render.json says.
-void remove_earlier_views(const std::filesystem::path& dir, const std::vector<std::string>& names) {
+void remove_earlier_file(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::remove(file, ec) && ec)
+    fail_file(file, "left by an earlier render, and cannot be removed: " + ec.message());
+}
+
+// What an earlier render into the folder leaves that would mix with this one, of the views
+// `names`: the views listed in its render.json that this one does not make (fewer path frames,
+// another split), and the report of eval's default location, which scored its views. Only files
+// that render wrote, and none outside the folder whatever render.json says.
+void remove_earlier_render(const std::filesystem::path& dir,
+                           const std::vector<std::string>& names) {
   const std::filesystem::path report = dir / "render.json";
   if (!std::filesystem::exists(report)) return;
+  for (const char* scores : {"metrics.json", "metrics.csv"}) remove_earlier_file(dir / scores);
   const nlohmann::json earlier = nlohmann::json::parse(read_file(report), nullptr, false);
   if (!earlier.is_object() || !earlier.contains("names") || !earlier["names"].is_array()) return;
   for (const nlohmann::json& name : earlier["names"]) {
@@ -64,11 +73,8 @@ void remove_earlier_views(const std::filesystem::path& dir, const std::vector<st
       continue;
     const pipeline::RenderedViewFiles files = pipeline::rendered_view_files(dir, view);
     for (const std::filesystem::path& file :
-         {files.rgb, files.depth_npy, files.depth_png, files.alpha}) {
-      std::error_code ec;
-      if (!std::filesystem::remove(file, ec) && ec)
-        fail_file(file, "an earlier render's view cannot be removed: " + ec.message());
-    }
+         {files.rgb, files.depth_npy, files.depth_png, files.alpha})
+      remove_earlier_file(file);
   }
 }
 
@@ -105,7 +111,7 @@ void run_render(const RenderArgs& args) {
              model.size(), args.scale, mode);
   std::vector<std::string> names;
   for (const Camera& camera : cameras) names.push_back(camera.name);
-  remove_earlier_views(args.output, names);
+  remove_earlier_render(args.output, names);
   const double seconds =
       pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
   nlohmann::json report = {{"views", cameras.size()},

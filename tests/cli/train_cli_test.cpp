@@ -57,6 +57,11 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   EXPECT_EQ(metrics["views"].size(), 2u);
   EXPECT_GT(metrics["mean"]["psnr"].get<double>(), 10.0);
   EXPECT_TRUE(std::filesystem::exists(dir / "same" / "metrics.csv"));
+  // Rendered again, the folder's scores of the earlier renders go with them.
+  ASSERT_EQ(iesrgs("render " + out + " " + scene + " -o " + same_size).status, 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "same" / "metrics.json"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "same" / "metrics.csv"));
+  ASSERT_EQ(iesrgs("eval " + same_size + " " + scene).status, 0);
 
   const CliRun mismatch = iesrgs("eval " + renders + " " + scene);
   EXPECT_EQ(mismatch.status, 1);
