@@ -4,7 +4,6 @@
 
 #include <vector>
 
-#include "gs/sh.hpp"
 #include "raster/rasterizer.hpp"
 #include "raster/synthetic_scene.hpp"
 #include "timing.hpp"
@@ -16,41 +15,25 @@ namespace {
 struct BenchFrame {
   RasterCamera<float> camera;
   GaussianCloud cloud;
-  std::vector<float> image, alpha, depth, pixel_grad;
-  std::vector<int32_t> radii;
-  std::vector<float> dmeans, dscales, dquats, dlogits, dsh_dc, dsh_rest, dview, dview_abs;
+  HostFrameBuffers buffers;
+  std::vector<float> pixel_grad;
   RasterFrame<float> frame;
   const float background[3] = {1, 1, 1};
 
   BenchFrame(int gaussians, int width, int height)
-      : camera(benchmark_camera(width, height)), cloud(synthetic_scene(gaussians, camera, 1)) {
-    const size_t plane = size_t(width) * height, n = size_t(gaussians);
-    image.resize(3 * plane);
-    alpha.resize(plane);
-    depth.resize(plane);
-    pixel_grad.assign(3 * plane, 1e-3f);
-    radii.resize(n);
-    dmeans.resize(3 * n);
-    dscales.resize(3 * n);
-    dquats.resize(4 * n);
-    dlogits.resize(n);
-    dsh_dc.resize(3 * n);
-    dsh_rest.resize(gs::kShRestFloats * n);
-    dview.resize(2 * n);
-    dview_abs.resize(2 * n);
-  }
+      : camera(benchmark_camera(width, height)),
+        cloud(synthetic_scene(gaussians, camera, 1)),
+        buffers(size_t(width) * height, size_t(gaussians)),
+        pixel_grad(3 * size_t(width) * height, 1e-3f) {}
   void forward() {
-    rasterize_forward(cloud.params(), camera, background, frame,
-                      RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
+    rasterize_forward(cloud.params(), camera, background, frame, buffers.targets());
   }
   void backward() {
     // The color gradient's first plane doubles as the alpha and depth gradients. The viewspace
     // gradients are asked for as training asks for them, for densification.
-    rasterize_backward(
-        cloud.params(), frame,
-        PixelGrads<float>{pixel_grad.data(), pixel_grad.data(), pixel_grad.data()},
-        GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(), dlogits.data(),
-                             dsh_dc.data(), dsh_rest.data(), dview.data(), dview_abs.data()});
+    rasterize_backward(cloud.params(), frame,
+                       PixelGrads<float>{pixel_grad.data(), pixel_grad.data(), pixel_grad.data()},
+                       buffers.gaussian_grads());
   }
 };
 

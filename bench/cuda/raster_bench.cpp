@@ -14,10 +14,10 @@
 #include "core/cuda/device_array.hpp"
 #include "core/error.hpp"
 #include "core/stopwatch.hpp"
-#include "gs/sh.hpp"
 #include "loss/cuda/ssim.hpp"
 #include "loss/ssim.hpp"
 #include "raster/cuda/rasterizer.hpp"
+#include "raster/rasterizer.hpp"
 #include "raster/synthetic_scene.hpp"
 
 namespace iesrgs::raster {
@@ -61,13 +61,6 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-// Gradient floats per Gaussian: GaussianGrads' arrays laid end to end.
-constexpr size_t kGradFloats = 3 + 3 + 4 + 1 + 3 + gs::kShRestFloats + 2 + 2;
-
-GaussianGrads<float> packed_grads(float* p, size_t n) {
-  return {p, p + 3 * n, p + 6 * n, p + 10 * n, p + 11 * n, p + 14 * n, p + 59 * n, p + 61 * n};
-}
-
 // Every buffer of one frame, forward and backward, on the device.
 struct CudaFrame {
   cuda::DeviceGaussians scene;
@@ -81,7 +74,7 @@ struct CudaFrame {
     depth.reserve(pixels);
     dimage.upload(std::vector<float>(3 * pixels, 1e-3f));
     radii.reserve(size_t(cloud.count()));
-    grads.reserve(size_t(cloud.count()) * kGradFloats);
+    grads.reserve(packed_grads_size(size_t(cloud.count())));
   }
   void forward(const RasterCamera<float>& cam) {
     const float background[3] = {1, 1, 1};
@@ -106,20 +99,18 @@ double time_frames(int frames, F&& f) {
 
 void bench_cpu(const GaussianCloud& cloud, const RasterCamera<float>& cam, int frames) {
   const size_t pixels = size_t(cam.width) * cam.height, n = size_t(cloud.count());
-  std::vector<float> image(3 * pixels), alpha(pixels), depth(pixels), dimage(3 * pixels, 1e-3f);
-  std::vector<int32_t> radii(n);
-  std::vector<float> grads(n * kGradFloats);
+  HostFrameBuffers buffers(pixels, n);
+  const std::vector<float> dimage(3 * pixels, 1e-3f);
   RasterFrame<float> frame;
   const float background[3] = {1, 1, 1};
   const auto forward = [&] {
-    rasterize_forward(cloud.params(), cam, background, frame,
-                      RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
+    rasterize_forward(cloud.params(), cam, background, frame, buffers.targets());
   };
   const double fwd = time_frames(frames, forward);
   const double both = time_frames(frames, [&] {
     forward();
     rasterize_backward(cloud.params(), frame, PixelGrads<float>{dimage.data(), nullptr, nullptr},
-                       packed_grads(grads.data(), n));
+                       buffers.gaussian_grads());
   });
   fmt::print("| {:>9} | CPU, {:>2} threads | {:>9.3f} | {:>9.3f} | {:>7.1f} | | | |\n", n,
              omp_get_max_threads(), fwd, both, 1000.0 / fwd);

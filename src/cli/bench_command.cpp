@@ -20,7 +20,6 @@
 #include "gs/benchmark_model.hpp"
 #include "gs/model.hpp"
 #include "gs/optimizer.hpp"
-#include "gs/sh.hpp"
 #include "io/model_file.hpp"
 #include "io/scene.hpp"
 #include "loss/benchmark_image.hpp"
@@ -151,11 +150,34 @@ struct RasterStageTimes {
   }
 };
 
+// Renders g seen by cam into the buffers (sized for it or larger), then differentiates the render
+// for the pixel gradients given.
+RasterStageTimes time_raster_frame(const raster::GaussianParams<float>& g,
+                                   const raster::RasterCamera<float>& cam,
+                                   const raster::PixelGrads<float>& pixel_grads,
+                                   raster::HostFrameBuffers& buffers,
+                                   raster::RasterFrame<float>& frame) {
+  using namespace raster;
+  const float background[3] = {1, 1, 1};
+  const Stopwatch watch;
+  rasterize_forward(g, cam, background, frame, buffers.targets());
+  const double forward_ms = watch.milliseconds();
+  rasterize_backward(g, frame, pixel_grads, buffers.gaussian_grads());
+  const RasterTimings& t = frame.timings;
+  return RasterStageTimes{forward_ms,
+                          t.project,
+                          t.bin,
+                          t.blend,
+                          t.blend_backward + t.project_backward,
+                          frame.bins.entry_count(),
+                          size_t(std::count_if(buffers.radii.begin(), buffers.radii.end(),
+                                               [](int r) { return r > 0; }))};
+}
+
 void run_raster_bench(const RasterBenchArgs& args) {
   apply(args.repeat);
   using namespace raster;
   const RasterWorkload w = args.model.empty() ? synthetic_workload(args) : trained_workload(args);
-  const GaussianParams<float>& g = w.params;
   const RasterCamera<float>& largest =
       *std::max_element(w.cameras.begin(), w.cameras.end(), [](const auto& a, const auto& b) {
         return size_t(a.width) * a.height < size_t(b.width) * b.height;
@@ -163,38 +185,16 @@ void run_raster_bench(const RasterBenchArgs& args) {
   const size_t plane = size_t(largest.width) * largest.height;
   require_memory(int64_t(plane) * kRasterBenchBytesPerPixel,
                  fmt::format("a {}x{} frame", largest.width, largest.height));
-  const size_t n = size_t(g.count);
-  std::vector<float> image(3 * plane), alpha(plane), depth(plane);
-  std::vector<int32_t> radii(n);
+  HostFrameBuffers buffers(plane, size_t(w.params.count));
   // A loss gradient that reaches every output.
   const std::vector<float> dimage(3 * plane, 1e-3f), dalpha(plane, 1e-3f), ddepth(plane, 1e-4f);
-  std::vector<float> dmeans(3 * n), dscales(3 * n), dquats(4 * n), dlogits(n), dsh_dc(3 * n),
-      dsh_rest(gs::kShRestFloats * n), dview(2 * n), dview_abs(2 * n);
-  const float background[3] = {1, 1, 1};
+  const PixelGrads<float> pixel_grads{dimage.data(), dalpha.data(), ddepth.data()};
   RasterFrame<float> frame;
-  const auto render_frame = [&](const RasterCamera<float>& cam) {
-    const Stopwatch watch;
-    rasterize_forward(g, cam, background, frame,
-                      RenderTargets<float>{image.data(), alpha.data(), depth.data(), radii.data()});
-    const double forward_ms = watch.milliseconds();
-    rasterize_backward(
-        g, frame, PixelGrads<float>{dimage.data(), dalpha.data(), ddepth.data()},
-        GaussianGrads<float>{dmeans.data(), dscales.data(), dquats.data(), dlogits.data(),
-                             dsh_dc.data(), dsh_rest.data(), dview.data(), dview_abs.data()});
-    const RasterTimings& t = frame.timings;
-    return RasterStageTimes{
-        forward_ms,
-        t.project,
-        t.bin,
-        t.blend,
-        t.blend_backward + t.project_backward,
-        frame.bins.entry_count(),
-        size_t(std::count_if(radii.begin(), radii.end(), [](int r) { return r > 0; }))};
-  };
   std::vector<RasterStageTimes> runs;
   const Timing total = time_runs(args.repeat.iterations, [&](int it) {
     RasterStageTimes sum;
-    for (const RasterCamera<float>& cam : w.cameras) sum += render_frame(cam);
+    for (const RasterCamera<float>& cam : w.cameras)
+      sum += time_raster_frame(w.params, cam, pixel_grads, buffers, frame);
     if (it >= 0) runs.push_back(sum);
   });
   const double frames = double(w.cameras.size());

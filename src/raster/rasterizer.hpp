@@ -4,6 +4,8 @@
 // gradients of every Gaussian parameter. Instantiated for float and double (gradient checks).
 #include <algorithm>
 #include <array>
+#include <cstdint>
+#include <vector>
 
 #include "gs/sh.hpp"
 #include "io/camera.hpp"
@@ -47,6 +49,45 @@ std::array<GradArray<T>, 8> grad_arrays(const GaussianGrads<T>& grads, size_t n)
            {grads.viewspace, 2 * n},
            {grads.viewspace_abs, 2 * n}}};
 }
+
+// Floats that every array of grads for n Gaussians takes, laid end to end (packed_grads).
+inline size_t packed_grads_size(size_t n) {
+  size_t floats = 0;
+  for (const GradArray<float>& a : grad_arrays(GaussianGrads<float>{}, n)) floats += a.size;
+  return floats;
+}
+
+// Every array of grads for n Gaussians in one buffer of packed_grads_size(n) floats at p.
+template <typename T>
+GaussianGrads<T> packed_grads(T* p, size_t n) {
+  GaussianGrads<T> g;
+  T** const fields[] = {&g.means, &g.log_scales, &g.quats,     &g.opacity_logits,
+                        &g.sh_dc, &g.sh_rest,    &g.viewspace, &g.viewspace_abs};
+  const std::array<GradArray<T>, 8> arrays = grad_arrays(g, n);  // their sizes, in this order
+  for (size_t k = 0; k < arrays.size(); ++k) {
+    *fields[k] = p;
+    p += arrays[k].size;
+  }
+  return g;
+}
+
+// Host buffers for one frame of n Gaussians: its render targets and every parameter gradient, for
+// the benchmarks that drive the rasterizer directly.
+struct HostFrameBuffers {
+  std::vector<float> image, alpha, depth, grads;
+  std::vector<int32_t> radii;
+
+  HostFrameBuffers(size_t pixels, size_t gaussians)
+      : image(3 * pixels),
+        alpha(pixels),
+        depth(pixels),
+        grads(packed_grads_size(gaussians)),
+        radii(gaussians) {}
+  RenderTargets<float> targets() {
+    return {image.data(), alpha.data(), depth.data(), radii.data()};
+  }
+  GaussianGrads<float> gaussian_grads() { return packed_grads(grads.data(), radii.size()); }
+};
 
 // Zeroes the gradients of Gaussians [begin, end) of n.
 template <typename T>

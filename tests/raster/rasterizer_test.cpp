@@ -324,6 +324,19 @@ TEST(RasterForward, HugeFiniteGaussianKeepsAPositiveRadius) {
   EXPECT_EQ(r.radii[0], 1 << 30);
 }
 
+TEST(RasterBackward, PackedGradsLayTheArraysEndToEnd) {
+  const size_t n = 5;
+  std::vector<float> buffer(packed_grads_size(n));
+  const GaussianGrads<float> grads = packed_grads(buffer.data(), n);
+  const float* next = buffer.data();
+  for (const GradArray<float>& a : grad_arrays(grads, n)) {
+    EXPECT_EQ(a.data, next);
+    next += a.size;
+  }
+  EXPECT_EQ(next, buffer.data() + buffer.size());
+  EXPECT_EQ(buffer.size(), n * (3 + 3 + 4 + 1 + 3 + gs::kShRestFloats + 2 + 2));
+}
+
 TEST(RasterForward, EmptySceneShowsBackground) {
   const Camera cam = test_camera(20, 17);
   const KernelRender<float> r =
