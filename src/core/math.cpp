@@ -21,6 +21,13 @@ double median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+std::vector<size_t> evenly_spaced(size_t total, size_t count) {
+  count = std::min(count, total);
+  std::vector<size_t> indices(count);
+  for (size_t i = 0; i < count; ++i) indices[i] = i * total / count;
+  return indices;
+}
+
 std::array<double, 4> rotation_to_quat(const Mat3& r) {
   const double trace = r(0, 0) + r(1, 1) + r(2, 2);
   double w, x, y, z;

@@ -86,6 +86,10 @@ Vec3 solve(const Mat3& a, const Vec3& b);
 // The middle value (the upper one of the two middle values for an even count); 0 when empty.
 double median(std::vector<double> values);
 
+// The indices of `count` of `total` items (all of them when count is larger), spread evenly from
+// the first: i * total / count.
+std::vector<size_t> evenly_spaced(size_t total, size_t count);
+
 // Rotation matrix from a unit quaternion (w, x, y, z), as COLMAP stores it.
 inline Mat3 quat_to_rotation(double w, double x, double y, double z) {
   Mat3 r;

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/math.hpp"
 #include "core/progress.hpp"
 #include "core/stopwatch.hpp"
 #include "eval/lpips.hpp"
@@ -390,9 +391,7 @@ RowResult Pipeline::run_fusion_row(const RowSpec& row) {
 void Pipeline::write_fusion_diagnostics(const gs::GaussianModel& model,
                                         const FusionSetup& setup) const {
   std::vector<DiagnosticView> views;
-  const size_t count = std::min(setup.cameras.size(), size_t(std::max(o_.diagnostic_views, 0)));
-  for (size_t k = 0; k < count; ++k) {
-    const size_t i = k * setup.cameras.size() / count;
+  for (size_t i : evenly_spaced(setup.cameras.size(), size_t(std::max(o_.diagnostic_views, 0)))) {
     const Camera& camera = setup.cameras[i];
     const RenderedView render = render_view(model, camera, setup.background);
     views.push_back({camera.name, setup.targets[i].external_image, setup.targets[i].internal_image,

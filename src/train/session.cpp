@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/math.hpp"
 #include "io/image_tensor.hpp"
 #include "io/model_file.hpp"
 #include "io/ply.hpp"
@@ -23,12 +24,9 @@ constexpr double kNerfSyntheticHalfExtent = 1.3;
 std::vector<TrainView> load_views(const Scene& scene, Split split, ViewImages& images,
                                   size_t limit) {
   const std::vector<const Camera*> cameras = scene.split(split);
-  const size_t count = limit == 0 ? cameras.size() : std::min(limit, cameras.size());
   std::vector<TrainView> views;
-  for (size_t i = 0; i < count; ++i) {
-    const Camera& camera = *cameras[i * cameras.size() / count];
-    views.push_back({camera, to_tensor(*images.rgb(camera))[0]});
-  }
+  for (size_t i : evenly_spaced(cameras.size(), limit == 0 ? cameras.size() : limit))
+    views.push_back({*cameras[i], to_tensor(*images.rgb(*cameras[i]))[0]});
   return views;
 }
 

@@ -16,6 +16,7 @@
 
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "core/math.hpp"
 #include "core/memory.hpp"
 #include "core/torch_error.hpp"
 #include "eval/metrics.hpp"
@@ -362,10 +363,10 @@ double Trainer::evaluate_psnr(const std::vector<TrainView>& views) const {
 
 double Trainer::report_test_psnr() {
   const std::vector<TrainView>& all = setup_.test_views;
-  const size_t count =
-      config_.test_views == 0 ? all.size() : std::min(all.size(), size_t(config_.test_views));
   std::vector<TrainView> subset;
-  for (size_t i = 0; i < count; ++i) subset.push_back(all[i * all.size() / count]);
+  for (size_t i :
+       evenly_spaced(all.size(), config_.test_views == 0 ? all.size() : size_t(config_.test_views)))
+    subset.push_back(all[i]);
   return evaluate_psnr(subset);
 }
 

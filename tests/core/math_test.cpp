@@ -5,6 +5,14 @@
 namespace iesrgs {
 namespace {
 
+TEST(Math, EvenlySpacedIndicesStartAtTheFirstAndStayInRange) {
+  EXPECT_EQ(evenly_spaced(10, 3), (std::vector<size_t>{0, 3, 6}));
+  EXPECT_EQ(evenly_spaced(4, 4), (std::vector<size_t>{0, 1, 2, 3}));
+  EXPECT_EQ(evenly_spaced(3, 7), (std::vector<size_t>{0, 1, 2}));
+  EXPECT_TRUE(evenly_spaced(5, 0).empty());
+  EXPECT_TRUE(evenly_spaced(0, 2).empty());
+}
+
 TEST(Math, QuaternionRoundTrip) {
   const double n = std::sqrt(0.3 * 0.3 + 0.5 * 0.5 + 0.1 * 0.1 + 0.8 * 0.8);
   const std::array<double, 4> q{0.3 / n, -0.5 / n, 0.1 / n, 0.8 / n};
