@@ -7,24 +7,13 @@
 
 #include "io/image.hpp"
 #include "io/npy.hpp"
-#include "support/looking_cameras.hpp"
+#include "support/one_gaussian.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs::pipeline {
 namespace {
 
-// One opaque red Gaussian at the origin, 4 units in front of the camera.
-struct OneGaussian {
-  gs::GaussianModel model;
-  Camera camera = testing::camera_at({0, -4, 0}, {0, 0, 0});
-
-  OneGaussian() {
-    model.set_params({torch::zeros({1, 3}), torch::tensor({1.7f, -1.7f, -1.7f}).view({1, 1, 3}),
-                      torch::zeros({1, 15, 3}), torch::full({1}, 6.0f),
-                      torch::full({1, 3}, std::log(0.3f)), torch::tensor({{1.f, 0.f, 0.f, 0.f}})});
-    camera.name = "v";
-  }
-};
+using testing::OneGaussian;
 
 TEST(RenderViews, ViewHasTheCamerasSizeAndExpectedDepth) {
   const OneGaussian scene;
