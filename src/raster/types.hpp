@@ -103,12 +103,30 @@ struct SplatGrad {
   T depth;
   T abs_x, abs_y;
 
+  // The members below name every field; a new field must join them (kFields).
+  static constexpr int kFields = 12;
+
   IESRGS_HD bool is_zero() const {
     return x == T(0) && y == T(0) && conic_xx == T(0) && conic_xy == T(0) && conic_yy == T(0) &&
            opacity == T(0) && color[0] == T(0) && color[1] == T(0) && color[2] == T(0) &&
            depth == T(0) && abs_x == T(0) && abs_y == T(0);
   }
+  IESRGS_HD SplatGrad& operator+=(const SplatGrad& o) {
+    x += o.x;
+    y += o.y;
+    conic_xx += o.conic_xx;
+    conic_xy += o.conic_xy;
+    conic_yy += o.conic_yy;
+    opacity += o.opacity;
+    for (int c = 0; c < 3; ++c) color[c] += o.color[c];
+    depth += o.depth;
+    abs_x += o.abs_x;
+    abs_y += o.abs_y;
+    return *this;
+  }
 };
+static_assert(sizeof(SplatGrad<float>) == SplatGrad<float>::kFields * sizeof(float),
+              "SplatGrad gained a field that is_zero and operator+= do not name");
 
 // Half-open pixel rectangle [x0, x1) x [y0, y1) outside which a splat's alpha is below 1/255.
 struct PixelRect {

@@ -272,7 +272,7 @@ struct PackedGrad {
   Pack<T> depth{}, abs_x{}, abs_y{};
 
   SplatGrad<T> sum() const {
-    static constexpr int kFields = sizeof(SplatGrad<T>) / sizeof(T);
+    static constexpr int kFields = SplatGrad<T>::kFields;
     static_assert(sizeof(PackedGrad) == kFields * sizeof(Pack<T>));
     Pack<T> fields[kFields];
     std::memcpy(fields, this, sizeof fields);
@@ -362,19 +362,7 @@ void reduce_entry_grads(RasterFrame<T>& frame) {
 #pragma omp parallel for schedule(static)
   for (int g = 0; g < count; ++g) {
     SplatGrad<T> sum{};
-    for (uint64_t s = start[g]; s < start[g + 1]; ++s) {
-      const SplatGrad<T>& e = frame.entry_grads[s];
-      sum.x += e.x;
-      sum.y += e.y;
-      sum.conic_xx += e.conic_xx;
-      sum.conic_xy += e.conic_xy;
-      sum.conic_yy += e.conic_yy;
-      sum.opacity += e.opacity;
-      for (int c = 0; c < 3; ++c) sum.color[c] += e.color[c];
-      sum.depth += e.depth;
-      sum.abs_x += e.abs_x;
-      sum.abs_y += e.abs_y;
-    }
+    for (uint64_t s = start[g]; s < start[g + 1]; ++s) sum += frame.entry_grads[s];
     frame.splat_grads[g] = sum;
   }
 }

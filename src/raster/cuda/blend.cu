@@ -80,8 +80,7 @@ __global__ void __launch_bounds__(kThreads)
   state.contributors[px.index] = contributors;
 }
 
-constexpr int kGradFields = sizeof(SplatGrad<float>) / sizeof(float);
-static_assert(sizeof(SplatGrad<float>) == kGradFields * sizeof(float), "SplatGrad is all floats");
+constexpr int kGradFields = SplatGrad<float>::kFields;  // all floats (raster/types.hpp)
 
 // Adds the warp's sum of one splat's per-pixel partials to its gradient.
 __device__ void add_warp_sum(const SplatGrad<float>& partial, SplatGrad<float>* target) {
