@@ -65,21 +65,24 @@ fs::path npm_dir() {
   return env_path("IESRGS_NPM_DIR").value_or(IESRGS_DEFAULT_NPM_DIR);
 }
 
-// The npm command spelled out, since setup installs only kSetupEsrganVariants; the loader was
-// checked against the 1.0.0 packages. It names setup's packages too: npm removes the unsaved
-// packages that a later install does not name.
+// The npm command spelled out, as setup runs it (which installs only kSetupEsrganVariants); the
+// loader was checked against the 1.0.0 packages. npm removes the unsaved packages that an install
+// does not name, so it names setup's and those already installed too.
 std::string install_hint(const std::string& variant, bool default_location) {
   const std::string name = "esrgan-" + variant;
   if (!default_location) return fmt::format("the folder is not an @upscalerjs/{} package", name);
+  const auto by_setup = [](const std::string& v) {
+    return std::find(std::begin(kSetupEsrganVariants), std::end(kSetupEsrganVariants), v) !=
+           std::end(kSetupEsrganVariants);
+  };
   std::vector<std::string> packages;
-  for (const char* installed : kSetupEsrganVariants)
-    packages.push_back(fmt::format("@upscalerjs/esrgan-{}@1.0.0", installed));
-  const bool from_setup =
-      std::find(std::begin(kSetupEsrganVariants), std::end(kSetupEsrganVariants), variant) !=
-      std::end(kSetupEsrganVariants);
-  if (!from_setup) packages.push_back(fmt::format("@upscalerjs/{}@1.0.0", name));
-  return fmt::format("npm install --prefix {} --no-save {} installs it{}", npm_dir().string(),
-                     fmt::join(packages, " "), from_setup ? ", and so does scripts/setup.sh" : "");
+  for (const Variant& known : kVariants)
+    if (by_setup(known.name) || known.name == variant ||
+        fs::exists(default_esrgan_package_dir(known.name)))
+      packages.push_back(fmt::format("@upscalerjs/esrgan-{}@1.0.0", known.name));
+  return fmt::format("npm install --prefix {} --no-save --omit=peer {} installs it{}",
+                     npm_dir().string(), fmt::join(packages, " "),
+                     by_setup(variant) ? ", and so does scripts/setup.sh" : "");
 }
 
 }  // namespace

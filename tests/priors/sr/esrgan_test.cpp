@@ -138,20 +138,28 @@ TEST(Esrgan, MissingPackageErrorSaysHowToInstallIt) {
   TempDir dir;
   const ScopedEnv npm_dir("IESRGS_NPM_DIR", dir.path().string());
   const std::string medium = error_message([] { make_esrgan("medium", 4, {}); });
-  // One command for every package: npm removes the unsaved ones an install does not name.
+  // One command for every package, setup's and those installed included: npm removes the
+  // unsaved ones an install does not name.
   const std::string command = "npm install --prefix " + dir.path().string() +
-                              " --no-save @upscalerjs/esrgan-thick@1.0.0 "
-                              "@upscalerjs/esrgan-slim@1.0.0";
-  EXPECT_NE(medium.find(command + " @upscalerjs/esrgan-medium@1.0.0 installs it)"),
+                              " --no-save --omit=peer @upscalerjs/esrgan-slim@1.0.0 ";
+  const std::string setup_packages = command + "@upscalerjs/esrgan-thick@1.0.0";
+  EXPECT_NE(medium.find(command + "@upscalerjs/esrgan-medium@1.0.0 "
+                                  "@upscalerjs/esrgan-thick@1.0.0 installs it)"),
             std::string::npos)
       << medium;
   EXPECT_EQ(medium.find("setup.sh"), std::string::npos) << medium;
   for (const char* variant : {"thick", "slim"}) {
     const std::string message = error_message([&] { make_esrgan(variant, 4, {}); });
-    EXPECT_NE(message.find(command + " installs it, and so does scripts/setup.sh"),
+    EXPECT_NE(message.find(setup_packages + " installs it, and so does scripts/setup.sh"),
               std::string::npos)
         << message;
   }
+  // A medium package installed by hand stays named when thick is missing.
+  std::filesystem::create_directories(dir / "node_modules" / "@upscalerjs" / "esrgan-medium");
+  const std::string thick = error_message([] { make_esrgan("thick", 4, {}); });
+  EXPECT_NE(thick.find("esrgan-medium@1.0.0 @upscalerjs/esrgan-thick@1.0.0 installs it"),
+            std::string::npos)
+      << thick;
 }
 
 TEST(Esrgan, PackageDirectoryFollowsTheEnvironment) {
