@@ -57,8 +57,8 @@ void remove_earlier_file(const std::filesystem::path& file) {
 
 // What an earlier render into the folder leaves that would mix with this one, of the views
 // `names`: the views listed in its render.json that this one does not make (fewer path frames,
-// another split), and the report of eval's default location, which scored its views. Only files
-// that render wrote, and none outside the folder whatever render.json says.
+// another split), and the report of eval's default location, which scored its views. Only those
+// files, and none outside the folder whatever render.json says.
 void remove_earlier_render(const std::filesystem::path& dir,
                            const std::vector<std::string>& names) {
   const std::filesystem::path report = dir / "render.json";

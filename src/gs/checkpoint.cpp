@@ -87,8 +87,9 @@ void load_training_state(const std::filesystem::path& path, GaussianModel& model
                          GaussianOptimizer& optimizer, DensifyStats& stats,
                          CheckpointExtras* extras) {
   // Checked and read through one mapping, so that the bytes loaded are the bytes checked even if
-  // the file is replaced meanwhile. The pages are dropped once read, as a copy of the whole file
-  // beside the tensors loaded from it would set the peak memory of a resume.
+  // the file is replaced meanwhile by a rename, as every writer here replaces files. The pages are
+  // dropped once read, as a copy of the whole file beside the tensors loaded from it would set the
+  // peak memory of a resume.
   const MappedFile file(path);
   try {
     // LibTorch's reader skips the CRCs, so damaged bytes would load as a different model.

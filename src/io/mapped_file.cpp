@@ -49,6 +49,8 @@ size_t MappedFile::read_through(size_t offset, void* out, size_t size) const {
 }
 
 void MappedFile::drop_pages(size_t offset, size_t size) const {
+  offset = std::min(offset, size_);  // never beyond the mapping, into a neighbouring one
+  size = std::min(size, size_ - offset);
   static const size_t page = size_t(::sysconf(_SC_PAGESIZE));
   const size_t first = (offset + page - 1) / page * page, end = (offset + size) / page * page;
   // Advice only: pages it leaves in place cost memory, not correctness.
