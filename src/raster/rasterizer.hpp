@@ -37,38 +37,54 @@ struct GradArray {
   size_t size;
 };
 
+// One array of GaussianGrads: its member and its floats per Gaussian.
+template <typename T>
+struct GradField {
+  using Member = T* GaussianGrads<T>::*;
+  Member array;
+  size_t per_gaussian;
+};
+
+// Every array of GaussianGrads, in the order of its members: the one list the helpers below read.
+template <typename T>
+constexpr std::array<GradField<T>, 8> grad_fields() {
+  using G = GaussianGrads<T>;
+  return {{{&G::means, 3},
+           {&G::log_scales, 3},
+           {&G::quats, 4},
+           {&G::opacity_logits, 1},
+           {&G::sh_dc, 3},
+           {&G::sh_rest, gs::kShRestFloats},
+           {&G::viewspace, 2},
+           {&G::viewspace_abs, 2}}};
+}
+
 // Every array of grads for n Gaussians, for the backward passes to clear.
 template <typename T>
 std::array<GradArray<T>, 8> grad_arrays(const GaussianGrads<T>& grads, size_t n) {
-  return {{{grads.means, 3 * n},
-           {grads.log_scales, 3 * n},
-           {grads.quats, 4 * n},
-           {grads.opacity_logits, n},
-           {grads.sh_dc, 3 * n},
-           {grads.sh_rest, gs::kShRestFloats * n},
-           {grads.viewspace, 2 * n},
-           {grads.viewspace_abs, 2 * n}}};
+  std::array<GradArray<T>, 8> arrays;
+  const auto fields = grad_fields<T>();
+  for (size_t k = 0; k < fields.size(); ++k)
+    arrays[k] = {grads.*fields[k].array, fields[k].per_gaussian * n};
+  return arrays;
 }
 
 // Floats that every array of grads for n Gaussians takes, laid end to end (packed_grads).
 inline size_t packed_grads_size(size_t n) {
   size_t floats = 0;
-  for (const GradArray<float>& a : grad_arrays(GaussianGrads<float>{}, n)) floats += a.size;
+  for (const GradField<float>& field : grad_fields<float>()) floats += field.per_gaussian * n;
   return floats;
 }
 
 // Every array of grads for n Gaussians in one buffer of packed_grads_size(n) floats at p.
 template <typename T>
 GaussianGrads<T> packed_grads(T* p, size_t n) {
-  GaussianGrads<T> g;
-  T** const fields[] = {&g.means, &g.log_scales, &g.quats,     &g.opacity_logits,
-                        &g.sh_dc, &g.sh_rest,    &g.viewspace, &g.viewspace_abs};
-  const std::array<GradArray<T>, 8> arrays = grad_arrays(g, n);  // their sizes, in this order
-  for (size_t k = 0; k < arrays.size(); ++k) {
-    *fields[k] = p;
-    p += arrays[k].size;
+  GaussianGrads<T> grads;
+  for (const GradField<T>& field : grad_fields<T>()) {
+    grads.*field.array = p;
+    p += field.per_gaussian * n;
   }
-  return g;
+  return grads;
 }
 
 // Host buffers for one frame of n Gaussians: its render targets and every parameter gradient, for
