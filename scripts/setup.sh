@@ -23,7 +23,7 @@ case "${1:-}" in
 esac
 
 PACKAGES=(
-  build-essential cmake pkg-config
+  build-essential cmake ninja-build pkg-config
   libtorch-dev          # tensors, autograd, Adam, .pth checkpoints
   libcli11-dev nlohmann-json3-dev libstb-dev libfmt-dev libspdlog-dev zlib1g-dev libzstd-dev
   libgtest-dev libgmock-dev libbenchmark-dev
@@ -50,6 +50,14 @@ if [ ! -f "$packages/esrgan-thick/models/x4/model.json" ] ||
       "to retry (until then --sr-model auto falls back to SAFMN or bicubic)" >&2
 fi
 
-cmake -S . -B "$build_dir" "${options[@]}" >/dev/null
+# Ninja, not Make: Make compiles no source of a target before the libraries it links are built,
+# Ninja only links later, which keeps both cores busy (docs/BENCHMARKS.md, "Build and CI time").
+# A folder configured by another generator is configured afresh (everything recompiles).
+cache=$build_dir/CMakeCache.txt
+if [ -f "$cache" ] && ! grep -qx "CMAKE_GENERATOR:INTERNAL=Ninja" "$cache"; then
+  echo "setup: $build_dir was configured for another generator; configuring it again for Ninja"
+  rm -rf "$cache" "$build_dir/CMakeFiles"
+fi
+cmake -S . -B "$build_dir" -G Ninja "${options[@]}" >/dev/null
 cmake --build "$build_dir" -j "$(nproc)" "${targets[@]}"
 echo "setup: built $build_dir/iesrgs"
