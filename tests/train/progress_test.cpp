@@ -23,7 +23,7 @@ std::vector<std::string> lines_of(const std::filesystem::path& file) {
 
 // A resumed run continues the log at its checkpoint: rows written after it, or cut off by a
 // killed process, go; the training time goes on from the checkpoint's.
-TEST(Progress, AResumedLogContinuesFromItsCheckpoint) {
+TEST(TrainProgress, AResumedLogContinuesFromItsCheckpoint) {
   testing::TempDir dir;
   const auto csv = dir / "train_log.csv";
   write_file_atomically(csv,
@@ -44,7 +44,7 @@ TEST(Progress, AResumedLogContinuesFromItsCheckpoint) {
 }
 
 // Rows every log_every iterations, and whenever a test PSNR comes in or the caller forces one.
-TEST(Progress, LogsEveryLogEveryIterations) {
+TEST(TrainProgress, LogsEveryLogEveryIterations) {
   testing::TempDir dir;
   const auto csv = dir / "train_log.csv";
   {
