@@ -122,9 +122,9 @@ void run_eval(const EvalArgs& args) {
   scene_args.options.downscale = args.downscale;
   scene_args.background = args.background;
   GroundTruth truth(args, scene_args.resolved());
+  const eval::LoadedLpips lpips = eval::load_default_lpips(args.lpips);
   eval::MetricsReport report;
-  const std::optional<eval::Lpips> lpips =
-      eval::load_default_lpips(args.lpips, report.lpips_status);
+  report.lpips_status = lpips.status;
   const std::vector<std::filesystem::path> files = render_files(args.renders);
   for (size_t i = 0; i < files.size(); ++i) {
     const std::string name = files[i].stem().string();
@@ -132,8 +132,7 @@ void run_eval(const EvalArgs& args) {
     const Image render = composite_rgb(read_image8(files[i]), truth.background());
     const Image reference = truth.get(name);
     try {
-      report.views.push_back(
-          eval::measure_view(name, render, reference, lpips ? &*lpips : nullptr));
+      report.views.push_back(eval::measure_view(name, render, reference, lpips.get()));
     } catch (const Error& e) {
       fail_file(files[i], e.what());
     }

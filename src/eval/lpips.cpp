@@ -237,19 +237,13 @@ float Lpips::distance(const torch::Tensor& a, const torch::Tensor& b) const {
   return total.item<float>();
 }
 
-std::optional<Lpips> load_default_lpips(const std::string& name, std::string& status) {
-  if (name == "none") {
-    status = "not computed (--lpips none)";
-    return std::nullopt;
-  }
+LoadedLpips load_default_lpips(const std::string& name) {
+  if (name == "none") return {std::nullopt, "not computed (--lpips none)"};
   const LpipsNet net = parse_lpips_net(name);
   const LpipsWeights weights = default_lpips_weights(net);
-  if (const auto missing = lpips_unavailable_reason(net, weights)) {
-    status = "unavailable: " + *missing;
-    return std::nullopt;
-  }
-  status = name;
-  return Lpips::load(net, weights);
+  if (const auto missing = lpips_unavailable_reason(net, weights))
+    return {std::nullopt, "unavailable: " + *missing};
+  return {Lpips::load(net, weights), name};
 }
 
 }  // namespace iesrgs::eval

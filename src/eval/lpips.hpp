@@ -60,9 +60,16 @@ class Lpips {
   std::shared_ptr<Networks> networks_;
 };
 
+// The metric as loaded once for every render it scores, and what a report says of it.
+struct LoadedLpips {
+  std::optional<Lpips> metric;  // absent for "none" or without its weights
+  std::string status;           // the net's name, or why the metric is absent
+
+  const Lpips* get() const { return metric ? &*metric : nullptr; }
+};
+
 // The metric from its default weights when "alex" or "vgg" names it and both files exist;
-// otherwise nullopt, with `status` saying why ("not computed" for "none", or the missing file).
-// On success `status` is the net's name.
-std::optional<Lpips> load_default_lpips(const std::string& name, std::string& status);
+// otherwise no metric, its status saying why ("not computed" for "none", or the missing file).
+LoadedLpips load_default_lpips(const std::string& name);
 
 }  // namespace iesrgs::eval

@@ -1,7 +1,5 @@
 #include "pipeline/evaluate.hpp"
 
-#include <optional>
-
 #include "io/image.hpp"
 #include "pipeline/render_views.hpp"
 
@@ -9,16 +7,16 @@ namespace iesrgs::pipeline {
 
 Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector<Camera>& cameras,
                                const std::array<float, 3>& background, ViewImages* truth,
-                               const std::string& lpips, const std::filesystem::path& dir) {
+                               const eval::LoadedLpips& lpips, const std::filesystem::path& dir) {
   Evaluation evaluation;
   evaluation.seconds_per_view = render_views_to(dir, model, cameras, background, 1.0);
   if (!truth) return evaluation;
   eval::MetricsReport& report = evaluation.report;
-  const std::optional<eval::Lpips> metric = eval::load_default_lpips(lpips, report.lpips_status);
+  report.lpips_status = lpips.status;
   for (const Camera& camera : cameras) {
     const Image render = to_float(read_image8(rendered_view_files(dir, camera.name).rgb));
     report.views.push_back(
-        eval::measure_view(camera.name, render, *truth->rgb(camera), metric ? &*metric : nullptr));
+        eval::measure_view(camera.name, render, *truth->rgb(camera), lpips.get()));
   }
   eval::write_report(dir / "metrics", report);
   return evaluation;

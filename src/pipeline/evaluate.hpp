@@ -19,10 +19,10 @@ struct Evaluation {
 };
 
 // Renders `cameras` into <dir>/{rgb,depth,alpha}; with `truth`, scores every render against
-// truth->rgb(camera) and writes <dir>/metrics.json and .csv. `lpips` as in
-// eval::load_default_lpips.
+// truth->rgb(camera), with LPIPS when `lpips` holds the metric, and writes <dir>/metrics.json
+// and .csv.
 Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector<Camera>& cameras,
                                const std::array<float, 3>& background, ViewImages* truth,
-                               const std::string& lpips, const std::filesystem::path& dir);
+                               const eval::LoadedLpips& lpips, const std::filesystem::path& dir);
 
 }  // namespace iesrgs::pipeline

@@ -115,8 +115,8 @@ class Pipeline {
   std::vector<ExternalView> external_, bicubic_;
   std::optional<InternalStage> internal_;
   nlohmann::json stages_ = nlohmann::json::object();
-  // What LPIPS the rows were scored with: the net's name, or why it was not computed.
-  std::string lpips_status_;
+  // The metric every row is scored with, loaded at the first row scored (the weights are large).
+  std::optional<eval::LoadedLpips> lpips_;
 };
 
 namespace {
@@ -354,18 +354,17 @@ gs::GaussianModel Pipeline::initial_hr_model() const {
 
 RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& model,
                                  const fs::path& dir) {
+  if (hr_images_ && !lpips_) lpips_ = eval::load_default_lpips(o_.lpips);
   const Stopwatch watch;
-  const Evaluation evaluation = render_and_evaluate(model, test_cameras(), lr_scene_.background,
-                                                    hr_images_.get(), o_.lpips, dir / "test");
+  const Evaluation evaluation =
+      render_and_evaluate(model, test_cameras(), lr_scene_.background, hr_images_.get(),
+                          lpips_ ? *lpips_ : eval::LoadedLpips{}, dir / "test");
   stages_["evaluation_seconds"][row.id] = watch.seconds();
   RowResult result;
   result.id = row.id;
   result.label = row_label(row);
   result.evaluated = !evaluation.report.views.empty();
-  if (result.evaluated) {
-    result.mean = evaluation.report.mean();
-    lpips_status_ = evaluation.report.lpips_status;
-  }
+  if (result.evaluated) result.mean = evaluation.report.mean();
   result.fps = evaluation.seconds_per_view > 0 ? 1 / evaluation.seconds_per_view : 0;
   return result;
 }
@@ -486,7 +485,7 @@ RunResult Pipeline::run() {
   // "lpips" is the net asked for, which earlier rows are matched by; the status says whether it
   // was computed.
   result.evaluation = {{"test_views", test_digest_}, {"lpips", o_.lpips}};
-  if (!lpips_status_.empty()) result.evaluation["lpips_status"] = lpips_status_;
+  if (lpips_) result.evaluation["lpips_status"] = lpips_->status;
   keep_earlier_rows(result);
   stages_["total_seconds_this_run"] = watch.seconds();
   result.stages = stages_;
