@@ -16,7 +16,6 @@
 
 #include "core/device.hpp"
 #include "core/error.hpp"
-#include "core/math.hpp"
 #include "core/memory.hpp"
 #include "core/torch_error.hpp"
 #include "eval/metrics.hpp"
@@ -361,15 +360,6 @@ double Trainer::evaluate_psnr(const std::vector<TrainView>& views) const {
   return views.empty() ? 0 : sum / double(views.size());
 }
 
-double Trainer::report_test_psnr() {
-  const std::vector<TrainView>& all = setup_.test_views;
-  std::vector<TrainView> subset;
-  for (size_t i :
-       evenly_spaced(all.size(), config_.test_views == 0 ? all.size() : size_t(config_.test_views)))
-    subset.push_back(all[i]);
-  return evaluate_psnr(subset);
-}
-
 TrainSummary Trainer::run() {
   InterruptScope interrupt_scope;
   TrainSummary summary;
@@ -388,7 +378,7 @@ TrainSummary Trainer::run() {
     std::optional<double> test_psnr;
     if (!setup_.test_views.empty() && config_.test_every > 0 &&
         (iteration_ % config_.test_every == 0 || last)) {
-      test_psnr = report_test_psnr();
+      test_psnr = evaluate_psnr(setup_.test_views);
       last_test_psnr_ = test_psnr;
     }
     // After the report: an opacity reset on the same iteration would make it read ~12 dB.

@@ -34,7 +34,9 @@ using ViewLoss = std::function<torch::Tensor(int view, const raster::RenderOutpu
 
 struct TrainerSetup {
   std::vector<TrainView> train_views;
-  std::vector<TrainView> test_views;  // for the periodic PSNR report; may be empty
+  // For the periodic PSNR report, every one scored (load_views picks config.test_views of the
+  // split); may be empty.
+  std::vector<TrainView> test_views;
   std::array<float, 3> background{1, 1, 1};
   double scene_extent = 1;
   std::filesystem::path output_dir;  // checkpoint.pt, train_log.csv, cameras.json go here
@@ -107,7 +109,6 @@ class Trainer {
   void warn_memory_cap(int64_t iteration, int64_t cap, int64_t held_back);
   void save_checkpoint();
   [[noreturn]] void fail_diverged(int64_t iteration, double loss) const;
-  double report_test_psnr();
   double training_seconds() const;
 
   TrainConfig config_;
