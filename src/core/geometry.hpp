@@ -88,14 +88,19 @@ IESRGS_HD Sym2<T> inverse_backward(const Sym2<T>& k, const Sym2<T>& dk) {
           -(kg10 * k.xy + kg11 * k.yy)};
 }
 
+// Rotation matrix of the unit quaternion (w, x, y, z).
+template <typename T>
+IESRGS_HD Mat3T<T> unit_quat_to_rotation(T w, T x, T y, T z) {
+  return {{{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+           {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+           {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
+}
+
 // Rotation matrix of the quaternion (w, x, y, z), normalized first.
 template <typename T>
 IESRGS_HD Mat3T<T> quat_to_rotation(const T* q) {
   const T inv = T(1) / hd::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  const T w = q[0] * inv, x = q[1] * inv, y = q[2] * inv, z = q[3] * inv;
-  return {{{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
-           {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
-           {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
+  return unit_quat_to_rotation(q[0] * inv, q[1] * inv, q[2] * inv, q[3] * inv);
 }
 
 // Gradient of the unnormalized quaternion from the gradient of quat_to_rotation(q).

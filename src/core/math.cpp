@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "core/geometry.hpp"
+
 namespace iesrgs {
 
 Vec3 solve(const Mat3& a, const Vec3& b) {
@@ -26,6 +28,14 @@ std::vector<size_t> evenly_spaced(size_t total, size_t count) {
   std::vector<size_t> indices(count);
   for (size_t i = 0; i < count; ++i) indices[i] = i * total / count;
   return indices;
+}
+
+Mat3 quat_to_rotation(double w, double x, double y, double z) {
+  const Mat3T<double> rotation = unit_quat_to_rotation(w, x, y, z);
+  Mat3 r;
+  for (int row = 0; row < 3; ++row)
+    for (int column = 0; column < 3; ++column) r(row, column) = rotation.m[row][column];
+  return r;
 }
 
 std::array<double, 4> rotation_to_quat(const Mat3& r) {

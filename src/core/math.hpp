@@ -91,13 +91,7 @@ double median(std::vector<double> values);
 std::vector<size_t> evenly_spaced(size_t total, size_t count);
 
 // Rotation matrix from a unit quaternion (w, x, y, z), as COLMAP stores it.
-inline Mat3 quat_to_rotation(double w, double x, double y, double z) {
-  Mat3 r;
-  r.m = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-         2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-         2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-  return r;
-}
+Mat3 quat_to_rotation(double w, double x, double y, double z);
 
 // Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method, numerically stable).
 std::array<double, 4> rotation_to_quat(const Mat3& r);
