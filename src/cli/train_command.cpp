@@ -110,7 +110,9 @@ void run_train(const TrainArgs& args) {
   // Only now that the scene and the starting model have loaded: a folder holding a config but no
   // checkpoint would make --resume fail on that instead of the real problem.
   if (!args.resume) {
-    train::remove_earlier_run(out);
+    if (train::remove_earlier_run(out))
+      spdlog::warn("{}: replaced the earlier run there (--resume continues a run instead)",
+                   out.string());
     write_file_atomically(out / "config.json", train::to_json(config).dump(2) + "\n");
   }
   const train::TrainSummary summary = trainer.run();

@@ -86,14 +86,16 @@ void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianMode
   write_ply_filter_baked(dir / "point_cloud_filter_baked.ply", cloud);
 }
 
-void remove_earlier_run(const std::filesystem::path& dir) {
+bool remove_earlier_run(const std::filesystem::path& dir) {
+  bool removed = false;
   for (const std::filesystem::path& file :
        {checkpoint_path(dir), dir / "train_log.csv", dir / "cameras.json", dir / "training.json",
         model_path(dir), dir / "point_cloud_filter_baked.ply"}) {
     std::error_code ec;
-    std::filesystem::remove(file, ec);
+    removed |= std::filesystem::remove(file, ec);
     if (ec) fail_file(file, "cannot be removed before a new run: " + ec.message());
   }
+  return removed;
 }
 
 std::filesystem::path trained_model_file(const std::filesystem::path& path) {

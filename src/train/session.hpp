@@ -46,8 +46,8 @@ void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianMode
 
 // Removes what an earlier training left in `dir` (checkpoint, log, point clouds, summary), before
 // a new run there: --resume would otherwise continue the earlier checkpoint under the new
-// config, and a render draw the earlier model.
-void remove_earlier_run(const std::filesystem::path& dir);
+// config, and a render draw the earlier model. Returns whether there was anything to remove.
+bool remove_earlier_run(const std::filesystem::path& dir);
 
 // A trained model given as its training folder (its point_cloud.ply) or as a model file. Throws
 // Error for a folder whose training has not finished.

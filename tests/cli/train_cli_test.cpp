@@ -33,6 +33,7 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
              " --set init=random");
   ASSERT_EQ(train.status, 0) << train.output;
   EXPECT_TRUE(contains(train.output, "it/s")) << train.output;
+  EXPECT_FALSE(contains(train.output, "replaced the earlier run")) << train.output;
   for (const char* file : {"point_cloud.ply", "point_cloud_filter_baked.ply", "config.json",
                            "training.json", "train_log.csv", "checkpoint.pt", "cameras.json"})
     EXPECT_TRUE(std::filesystem::exists(dir / "run" / file)) << file;
@@ -229,8 +230,10 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
       << black.output;
 
   // A new run into the folder replaces the earlier one whole: no checkpoint of it is left for a
-  // --resume to continue under the new config, and the log starts again.
-  ASSERT_EQ(iesrgs(train + " --preset fast --iterations 5 --set random_points=500").status, 0);
+  // --resume to continue under the new config, and the log starts again. The user is told.
+  const CliRun replaced = iesrgs(train + " --preset fast --iterations 5 --set random_points=500");
+  ASSERT_EQ(replaced.status, 0) << replaced.output;
+  EXPECT_TRUE(contains(replaced.output, "replaced the earlier run there")) << replaced.output;
   EXPECT_EQ(read_file(dir / "run" / "train_log.csv").find("\n10,"), std::string::npos);
   EXPECT_EQ(nlohmann::json::parse(read_file(dir / "run" / "training.json"))["iterations"], 5);
 }
