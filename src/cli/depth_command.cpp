@@ -7,7 +7,6 @@
 #include "cli/commands.hpp"
 #include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
-#include "core/device.hpp"
 #include "core/error.hpp"
 #include "core/progress.hpp"
 #include "io/image.hpp"
@@ -31,14 +30,13 @@ void run_depth(const DepthArgs& args) {
   use_device(args.device);
   const std::vector<DepthJob> jobs = priors::depth::plan_depth_jobs(args.in, args.out);
   const std::unique_ptr<priors::depth::DepthNet> net =
-      priors::depth::make_depth_net(args.model, args.weights, compute_device());
+      priors::depth::make_depth_net(args.model, args.weights);
   if (!net) fail("depth: model '{}' predicts nothing, so there is nothing to write", args.model);
   const float background[3] = {args.background, args.background, args.background};
   ItemPace pace(jobs.size());
   for (size_t i = 0; i < jobs.size(); ++i) {
     const Image rgb = composite_rgb(read_image8(jobs[i].image), background);
-    priors::depth::write_depth_outputs(net->predict(to_tensor(rgb).to(compute_device())).cpu(),
-                                       jobs[i]);
+    priors::depth::write_depth_outputs(net->predict(to_tensor(rgb)), jobs[i]);
     fmt::print("[{}/{}] {} -> {} ({}x{}, {})\n", i + 1, jobs.size(), jobs[i].image.string(),
                jobs[i].npy.string(), rgb.width, rgb.height, pace.finished(i + 1));
   }

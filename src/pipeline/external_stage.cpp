@@ -5,7 +5,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/device.hpp"
 #include "core/error.hpp"
 #include "core/progress.hpp"
 #include "core/stopwatch.hpp"
@@ -106,8 +105,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
     if (view_cached(record, fingerprint, view, camera, options.scale)) continue;
     if (!loaded) {
       sr = priors::sr::make_sr_net(options.sr_model, options.sr_weights, options.scale);
-      depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights,
-                                            compute_device());
+      depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights);
       loaded = true;
     }
     // Forget the view's old entry first: a run killed between the writes below must not leave
@@ -119,7 +117,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
     if (depth) {
       // Depth of E_image as the model saw it: the 8-bit image written above.
       const torch::Tensor seen = to_tensor(to_float(read_image8(view.image)));
-      priors::depth::write_depth_outputs(depth->predict(seen.to(compute_device())).cpu(),
+      priors::depth::write_depth_outputs(depth->predict(seen),
                                          priors::depth::depth_job(view.image, view.depth));
     }
     record[camera.name] = fingerprint;

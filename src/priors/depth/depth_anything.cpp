@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "priors/compute_device.hpp"
 
 namespace iesrgs::priors::depth {
 
@@ -80,20 +81,18 @@ torch::Tensor network_input(const torch::Tensor& rgb, int short_side) {
 }
 
 DepthAnythingNet::DepthAnythingNet(DepthAnythingV2 model, std::string name, int short_side)
-    : model_(std::move(model)),
-      name_(std::move(name)),
-      short_side_(short_side),
-      device_(model_->parameters().front().device()) {}
+    : model_(std::move(model)), name_(std::move(name)), short_side_(short_side) {}
 
 torch::Tensor DepthAnythingNet::predict(const torch::Tensor& rgb) {
   if (rgb.dim() != 4 || rgb.size(0) != 1 || rgb.size(1) != 3)
     fail("{}: expected an RGB batch of shape (1, 3, H, W), got {}", name_,
          fmt::join(rgb.sizes(), "x"));
   torch::NoGradGuard no_grad;
-  const torch::Tensor depth = model_->forward(network_input(rgb.to(device_), short_side_));
-  const torch::Tensor resized = torch::upsample_bilinear2d(
-      depth.unsqueeze(1), {rgb.size(2), rgb.size(3)}, /*align_corners=*/true);
-  return resized[0][0].to(rgb.device());
+  return on_compute_device(*model_, rgb, [&](const torch::Tensor& x) {
+    const torch::Tensor depth = model_->forward(network_input(x, short_side_));
+    return torch::upsample_bilinear2d(depth.unsqueeze(1), {rgb.size(2), rgb.size(3)},
+                                      /*align_corners=*/true)[0][0];
+  });
 }
 
 }  // namespace iesrgs::priors::depth

@@ -57,7 +57,6 @@ torch::Tensor network_input(const torch::Tensor& rgb, int short_side);
 
 class DepthAnythingNet : public DepthNet {
  public:
-  // Runs on the device of `model`'s parameters.
   DepthAnythingNet(DepthAnythingV2 model, std::string name, int short_side = 518);
   std::string name() const override { return name_; }
   // The network output resized back to H x W, bilinearly with corners aligned.
@@ -67,7 +66,6 @@ class DepthAnythingNet : public DepthNet {
   DepthAnythingV2 model_;
   std::string name_;
   int short_side_;
-  torch::Device device_;
 };
 
 }  // namespace iesrgs::priors::depth

@@ -28,8 +28,7 @@ std::string requested_encoder(const std::string& model) {
 }  // namespace
 
 std::unique_ptr<DepthNet> make_depth_net(const std::string& model,
-                                         const std::filesystem::path& weights,
-                                         torch::Device device) {
+                                         const std::filesystem::path& weights) {
   if (model == "none") {
     spdlog::info("depth model: none, so the external depth loss is off");
     return nullptr;
@@ -55,7 +54,6 @@ std::unique_ptr<DepthNet> make_depth_net(const std::string& model,
               fmt::format("holds a Depth Anything V2 {} model, not the {} that {} asks for",
                           encoder, requested, model));
   DepthAnythingV2 network = load_depth_anything(depth_anything_config(encoder), state, weights);
-  network->to(device);
   spdlog::info("depth model: Depth Anything V2 {} from {}", encoder, weights.string());
   return std::make_unique<DepthAnythingNet>(std::move(network), kDepthAnything + "-" + encoder);
 }

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "io/image_tensor.hpp"
+#include "priors/compute_device.hpp"
 #include "priors/sr/sr_net.hpp"
 
 namespace iesrgs::priors::sr {

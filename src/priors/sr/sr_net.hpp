@@ -5,8 +5,6 @@
 
 #include <string>
 
-#include "core/device.hpp"
-
 namespace iesrgs::priors::sr {
 
 class SrNet {
@@ -19,16 +17,5 @@ class SrNet {
   // padding the network needs (e.g. to a window multiple) happens inside and is cropped off again.
   virtual torch::Tensor upscale(const torch::Tensor& rgb) = 0;
 };
-
-// forward(input) on the process's compute device (core/device.hpp), with `module` moved there
-// (a no-op once it is): the input goes there, the result comes back to the CPU, where the
-// callers keep their images.
-template <class Forward>
-torch::Tensor on_compute_device(torch::nn::Module& module, const torch::Tensor& input,
-                                Forward&& forward) {
-  const torch::Device device = compute_device();
-  module.to(device);
-  return forward(input.to(device)).to(torch::kCPU);
-}
 
 }  // namespace iesrgs::priors::sr
