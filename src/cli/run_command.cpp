@@ -7,6 +7,7 @@
 #include "cli/scene_options.hpp"
 #include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
+#include "core/error.hpp"
 #include "pipeline/ie_srgs.hpp"
 #include "pipeline/rows.hpp"
 #include "train/config.hpp"
@@ -45,8 +46,18 @@ struct RunArgs {
   std::string device = "auto";
 };
 
+// The HR rows' texture loss takes its D-SSIM weight from --dssim: the HR training config's own
+// would go unused.
+void refuse_unused_fusion_keys(const TrainingArgs& fusion) {
+  for (const std::string& assignment : fusion.assignments)
+    if (assignment.rfind("dssim_weight=", 0) == 0)
+      fail("--set {}: the HR model's texture loss takes its D-SSIM weight from --dssim",
+           assignment);
+}
+
 void run_pipeline(const RunArgs& args, pipeline::StageSelection only) {
   use_device(args.device);
+  refuse_unused_fusion_keys(args.fusion);
   pipeline::RunOptions options = args.options;
   options.scene = args.scene.path;
   options.scene_options = args.scene.resolved();

@@ -192,6 +192,11 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_NE(dssim.status, 0);
   EXPECT_TRUE(contains(dssim.output, "must be a number in [0, 1], got nan")) << dssim.output;
 
+  const CliRun unused = iesrgs("run " + scene + " -o " + out + " --set dssim_weight=0.5");
+  EXPECT_EQ(unused.status, 1);
+  EXPECT_TRUE(contains(last_line(unused.output), "takes its D-SSIM weight from --dssim"))
+      << unused.output;
+
   const CliRun threshold = iesrgs("run " + scene + " -o " + out + " --threshold -0.5");
   EXPECT_NE(threshold.status, 0);
   EXPECT_TRUE(contains(threshold.output, "--threshold: must be at least 0, got -0.5"))
