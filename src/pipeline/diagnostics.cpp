@@ -91,8 +91,13 @@ void write_diagnostics(const fs::path& dir, const std::vector<DiagnosticView>& v
     const torch::Tensor blank = torch::zeros_like(view.render);
     std::vector<torch::Tensor> row;
     for (size_t c = 0; c < kColumns.size(); ++c) {
-      if (pictures[c].defined())
-        write_tensor_png(dir / view.name / (std::string(kColumns[c]) + ".png"), pictures[c]);
+      const fs::path file = dir / view.name / (std::string(kColumns[c]) + ".png");
+      if (pictures[c].defined()) {
+        write_tensor_png(file, pictures[c]);
+      } else {
+        std::error_code ignored;  // an earlier run's picture would pass for this run's
+        fs::remove(file, ignored);
+      }
       row.push_back(pictures[c].defined() ? pictures[c] : blank);
     }
     rows.push_back(torch::cat(row, 2));

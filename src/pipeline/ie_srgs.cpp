@@ -421,6 +421,11 @@ torch::Tensor Pipeline::train_truth(size_t i, const Camera& camera) const {
 }
 
 void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
+  const fs::path path = o_.output / "diagnostics" / "mask_agreement.json";
+  // Without both references and the truth there is nothing to check, and an earlier run's
+  // check would pass for this run's.
+  std::error_code ignored;
+  fs::remove(path, ignored);
   eval::MaskCounts counts;
   for (size_t i = 0; i < setup.cameras.size(); ++i) {
     const loss::FusionTargets& targets = setup.targets[i];
@@ -442,7 +447,6 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
                                {"psnr_fused", counts.fused_psnr()},
                                {"oracle_mask_share", counts.oracle_mask_share()},
                                {"psnr_oracle", counts.oracle_psnr()}};
-  const fs::path path = o_.output / "diagnostics" / "mask_agreement.json";
   write_file_atomically(path, json.dump(2) + "\n");
   fmt::print(
       "mask M on {:.2f}% of the training pixels, the truth's mask G on {:.2f}%: IoU {:.3f}, "

@@ -5,7 +5,9 @@
 
 #include <array>
 #include <filesystem>
+#include <string>
 
+#include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "support/temp_dir.hpp"
 
@@ -61,6 +63,20 @@ TEST(Diagnostics, NoTruthNoMaskCheck) {
   EXPECT_FALSE(std::filesystem::exists(dir / "v" / "mask_check.png"));
   EXPECT_FALSE(std::filesystem::exists(dir / "v" / "truth.png"));
   EXPECT_EQ(read_image8(dir / "contact_sheet.png").width, 8 * 4);
+}
+
+// Written again without the internal image, the view keeps none of the earlier run's pictures
+// of it, which would pass for this run's.
+TEST(Diagnostics, PicturesThisRunLacksAreRemoved) {
+  TempDir dir;
+  const torch::Tensor gray = row_image({0.5f, 0.5f, 0.5f, 0.5f});
+  write_diagnostics(dir.path(), {{"v", gray, gray, gray, torch::ones({1, 4}), gray}}, 0.6);
+  ASSERT_TRUE(std::filesystem::exists(dir / "v" / "mask_check.png"));
+  write_diagnostics(dir.path(), {{"v", gray, {}, gray, torch::ones({1, 4}), gray}}, 0.6);
+  for (const char* picture : {"internal", "discrepancy", "mask", "mask_check"})
+    EXPECT_FALSE(std::filesystem::exists(dir / "v" / (std::string(picture) + ".png"))) << picture;
+  EXPECT_TRUE(std::filesystem::exists(dir / "v" / "external.png"));
+  EXPECT_EQ(read_file(dir / "contact_sheet.html").find("mask.png"), std::string::npos);
 }
 
 }  // namespace
