@@ -37,6 +37,11 @@ TEST(ExternalStage, SuperResolvesEveryTrainingViewOnceAndRecomputesOnChange) {
 
   run_external_stage(scene, images, options, dir / "ext");  // cached: nothing rewritten
   EXPECT_EQ(std::filesystem::last_write_time(views[0].image), written);
+  // Depth weights are unused without a depth model: naming a file changes nothing.
+  ExternalOptions unused_weights = options;
+  unused_weights.depth_weights = dir / "scene" / "transforms_train.json";
+  run_external_stage(scene, images, unused_weights, dir / "ext");
+  EXPECT_EQ(std::filesystem::last_write_time(views[0].image), written);
 
   // The same bytes written again (a copied dataset) keep the cache; an edited image does not.
   const Camera& first = *scene.split(Split::Train)[0];
