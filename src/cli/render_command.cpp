@@ -78,6 +78,19 @@ void remove_earlier_render(const std::filesystem::path& dir,
   }
 }
 
+// Checked before scaling, which rounds to int: a side beyond 2^16 is no render anyone can store.
+// Every view, since a scene's cameras may differ in size.
+void require_render_sizes(const std::vector<Camera>& cameras, double scale,
+                          const std::filesystem::path& scene) {
+  for (const Camera& camera : cameras) {
+    const double width = camera.intrinsics.width * scale, height = camera.intrinsics.height * scale;
+    if (std::min(width, height) < 0.5 || std::max(width, height) > 65536)
+      fail_file(scene, fmt::format("--scale {}: view {} would be {:.0f}x{:.0f} pixels (1 to 65536 "
+                                   "a side)",
+                                   scale, camera.name, width, height));
+  }
+}
+
 void run_render(const RenderArgs& args) {
   use_device(args.device);
   gs::GaussianModel model =
@@ -93,16 +106,17 @@ void run_render(const RenderArgs& args) {
   } else {
     const std::vector<const Camera*> train = scene.split(Split::Train);
     if (train.empty()) fail_file(scene.root, "has no training views to fit a camera path to");
-    cameras = args.path == "orbit" ? pipeline::orbit_path(train, args.frames)
-                                   : pipeline::interpolated_path(train, args.frames);
+    try {
+      cameras = args.path == "orbit" ? pipeline::orbit_path(train, args.frames)
+                                     : pipeline::interpolated_path(train, args.frames);
+    } catch (const Error& e) {
+      fail_file(scene.root, e.what());  // the path cannot be fitted to this scene's cameras
+    }
   }
   if (cameras.empty()) fail_file(scene.root, fmt::format("has no {} views", args.split));
-  // Checked before scaling, which rounds to int: a side beyond 2^16 is no render anyone can store.
-  const double width = cameras.front().intrinsics.width * args.scale,
-               height = cameras.front().intrinsics.height * args.scale;
-  if (std::min(width, height) < 0.5 || std::max(width, height) > 65536)
-    fail("--scale {}: the {} views would be {:.0f}x{:.0f} pixels (1 to 65536 a side)", args.scale,
-         what, width, height);
+  require_render_sizes(cameras, args.scale, scene.root);
+  // Before anything of an earlier render is removed.
+  pipeline::require_render_memory(cameras, args.scale);
   const Camera first = cameras.front().scaled(args.scale);
   // Two renders into one folder would leave a mix of two models' views.
   const FolderLock lock(args.output);
@@ -112,22 +126,28 @@ void run_render(const RenderArgs& args) {
   std::vector<std::string> names;
   for (const Camera& camera : cameras) names.push_back(camera.name);
   remove_earlier_render(args.output, names);
-  const double seconds =
-      pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
   nlohmann::json report = {{"views", cameras.size()},
                            {"width", first.intrinsics.width},
                            {"height", first.intrinsics.height},
                            {"gaussians", model.size()},
                            {"rasterize_mode", mode},
-                           {"seconds_per_view", seconds},
-                           {"fps", seconds > 0 ? 1.0 / seconds : 0.0},
-                           {"names", names}};
+                           {"names", names},
+                           {"finished", false}};
   // What eval checks its ground truth against.
   if (args.path.empty())
     report["split"] = args.split;
   else
     report["path"] = args.path;
-  write_file_atomically(std::filesystem::path(args.output) / "render.json", report.dump(2) + "\n");
+  // Recorded first, so that a render stopped partway is known for one (eval refuses it) and the
+  // next render into the folder removes its views.
+  const std::filesystem::path record = std::filesystem::path(args.output) / "render.json";
+  write_file_atomically(record, report.dump(2) + "\n");
+  const double seconds =
+      pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
+  report["seconds_per_view"] = seconds;
+  report["fps"] = seconds > 0 ? 1.0 / seconds : 0.0;
+  report["finished"] = true;
+  write_file_atomically(record, report.dump(2) + "\n");
   fmt::print("{:.1f} ms per view ({:.1f} FPS); wrote {}\n", seconds * 1e3,
              seconds > 0 ? 1.0 / seconds : 0.0, args.output);
 }

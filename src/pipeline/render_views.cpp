@@ -23,20 +23,6 @@ constexpr float kMinAlphaForDepth = 1e-4f;
 // 4096x4096 renders, and a margin for the Gaussians' own buffers, which that growth leaves out.
 constexpr int64_t kRenderBytesPerPixel = 64;
 
-// Refuses views too large for the memory before rendering any: the kernel would kill the process
-// partway through. The CPU's alone, which holds every view's outputs and encodes the files: on a
-// GPU the free memory leaves out what LibTorch has cached, and running out there is an error
-// LibTorch reports.
-void require_render_memory(const std::vector<Camera>& cameras, double scale) {
-  Intrinsics largest;
-  for (const Camera& camera : cameras) {
-    const Intrinsics size = camera.scaled(scale).intrinsics;
-    if (int64_t(size.width) * size.height > int64_t(largest.width) * largest.height) largest = size;
-  }
-  require_memory(int64_t(largest.width) * largest.height * kRenderBytesPerPixel,
-                 fmt::format("rendering {}x{} views", largest.width, largest.height));
-}
-
 std::vector<float> to_vector(const torch::Tensor& tensor) {
   const torch::Tensor flat = tensor.contiguous().view(-1);
   return std::vector<float>(flat.data_ptr<float>(), flat.data_ptr<float>() + flat.numel());
@@ -50,6 +36,16 @@ Image8 gray_image8(const torch::Tensor& plane) {
 }
 
 }  // namespace
+
+void require_render_memory(const std::vector<Camera>& cameras, double scale) {
+  Intrinsics largest;
+  for (const Camera& camera : cameras) {
+    const Intrinsics size = camera.scaled(scale).intrinsics;
+    if (int64_t(size.width) * size.height > int64_t(largest.width) * largest.height) largest = size;
+  }
+  require_memory(int64_t(largest.width) * largest.height * kRenderBytesPerPixel,
+                 fmt::format("rendering {}x{} views", largest.width, largest.height));
+}
 
 RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
                          const std::array<float, 3>& background) {

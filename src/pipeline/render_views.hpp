@@ -35,6 +35,12 @@ RenderedViewFiles rendered_view_files(const std::filesystem::path& dir, const st
 void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
                          const RenderedView& view);
 
+// Refuses views too large for the memory before rendering any: the kernel would kill the process
+// partway through. The CPU's alone, which holds every view's outputs and encodes the files: on a
+// GPU the free memory leaves out what LibTorch has cached, and running out there is an error
+// LibTorch reports.
+void require_render_memory(const std::vector<Camera>& cameras, double scale);
+
 // Renders every camera (at `scale` times its resolution) into `dir`, printing progress; returns
 // the mean rendering time in seconds per view, after one untimed warm-up frame.
 double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,

@@ -85,16 +85,29 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
     EXPECT_FALSE(std::filesystem::exists(dir / "orbit" / folder / "path_0002.png")) << folder;
   EXPECT_TRUE(std::filesystem::exists(dir / "orbit" / "rgb" / "path_0001.png"));
   // A render needing about twice the available memory is refused before the kernel would kill the
-  // process (64 bytes a pixel; sized from this host's memory, when it is under 128 GiB).
+  // process (64 bytes a pixel; sized from this host's memory, when it is under 128 GiB), and
+  // before anything of the earlier render in the folder is removed.
   const int64_t available = available_memory_bytes();
   const int huge_scale = int(std::ceil(std::sqrt(2.0 * double(available) / 64) / 32));
   if (available > 0 && 32 * huge_scale <= 65536) {
-    const CliRun huge = iesrgs("render " + out + " " + scene + " -o " + (dir / "huge").string() +
-                               " --scale " + std::to_string(huge_scale));
+    const CliRun huge = iesrgs("render " + out + " " + scene + " -o " + same_size +
+                               " --path orbit --frames 2 --scale " + std::to_string(huge_scale));
     EXPECT_EQ(huge.status, 1);
     EXPECT_TRUE(contains(last_line(huge.output), "not enough memory: rendering")) << huge.output;
-    EXPECT_FALSE(std::filesystem::exists(dir / "huge" / "rgb"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "same" / "metrics.json"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "same" / "rgb" / "r_1.png"));
   }
+  // A render that stopped partway is no render to score.
+  const std::string record = read_file(dir / "same" / "render.json");
+  auto unfinished = nlohmann::json::parse(record);
+  EXPECT_EQ(unfinished["finished"], true);
+  unfinished["finished"] = false;
+  write_file_atomically(dir / "same" / "render.json", unfinished.dump());
+  const CliRun stopped = iesrgs("eval --lpips none " + same_size + " " + scene);
+  EXPECT_EQ(stopped.status, 1);
+  EXPECT_TRUE(contains(last_line(stopped.output), "render.json: this render did not finish"))
+      << stopped.output;
+  write_file_atomically(dir / "same" / "render.json", record);
   // A render.json naming files outside its folder removes none of them.
   write_file_atomically(dir / "keep.png", "x");
   write_file_atomically(dir / "orbit" / "render.json", R"({"names": ["../../keep"]})");
