@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <map>
 
 #include <nlohmann/json.hpp>
 
@@ -38,21 +39,32 @@ struct EvalArgs {
 std::vector<std::filesystem::path> render_files(std::filesystem::path dir) {
   if (std::filesystem::is_directory(dir / "rgb")) dir /= "rgb";
   if (!std::filesystem::is_directory(dir)) fail_file(dir, "is not a folder of rendered images");
-  return image_files_in(dir);
+  std::vector<std::filesystem::path> files = image_files_in(dir);
+  // a.png and a.jpg would both be scored as view a, which would count twice in the mean.
+  std::map<std::string, std::filesystem::path> by_stem;
+  for (const std::filesystem::path& file : files)
+    if (const auto [it, added] = by_stem.emplace(file.stem().string(), file); !added)
+      fail_file(dir,
+                fmt::format("{} and {} are both renders of view {}; keep one",
+                            it->second.filename().string(), file.filename().string(), it->first));
+  return files;
 }
 
-// Refuses renders that `iesrgs render` made of other cameras than the ground truth's split, as
-// its render.json records them: names alone do not tell (NeRF Synthetic's splits both start at
-// r_0).
-void check_rendered_split(const EvalArgs& args) {
+// Refuses a render that `iesrgs render` did not finish, and one of other cameras than the ground
+// truth's split, as its render.json records them: names alone do not tell (NeRF Synthetic's
+// splits both start at r_0).
+void check_render_record(const EvalArgs& args) {
   std::filesystem::path folder = args.renders;
   if (!folder.has_filename()) folder = folder.parent_path();  // given as "out/rgb/"
   if (folder.filename() == "rgb" && !std::filesystem::exists(folder / "render.json"))
     folder = folder.parent_path();
   const std::filesystem::path record = folder / "render.json";
-  if (!is_scene(args.ground_truth) || !std::filesystem::exists(record)) return;
+  if (!std::filesystem::exists(record)) return;
   const nlohmann::json report = nlohmann::json::parse(read_file(record), nullptr, false);
   if (!report.is_object()) return;
+  if (const auto finished = report.find("finished"); finished != report.end() && *finished == false)
+    fail_file(record, "this render did not finish: render again before scoring it");
+  if (!is_scene(args.ground_truth)) return;
   if (report.contains("path"))
     fail_file(record, "these renders are frames of a camera path, which have no ground truth");
   const auto recorded = report.find("split");
@@ -76,20 +88,26 @@ class GroundTruth {
       scene_.emplace(load_scene(root_, options));
       images_.emplace(*scene_);
       const Split split = args.split == "train" ? Split::Train : Split::Test;
-      for (const Camera* camera : scene_->split(split)) cameras_[camera->name] = camera;
+      for (const Camera* camera : scene_->split(split)) {
+        cameras_[camera->name] = camera;
+        names_.push_back(camera->name);
+      }
+    } else {
+      for (const std::filesystem::path& image : image_files_in(root_))
+        names_.push_back(image.stem().string());
     }
   }
 
   const float* background() const { return background_.data(); }
 
-  // The scene views of the split that no render was scored against (none for a plain folder).
+  // The ground truth's views (the split's, or the folder's images) that no render was scored
+  // against.
   std::vector<std::string> unscored(const std::vector<eval::ViewMetrics>& scored) const {
     std::vector<std::string> names;
-    // By entry, not structured binding: C++17 lambdas cannot capture a binding.
-    for (const auto& entry : cameras_)
+    for (const std::string& name : names_)
       if (std::none_of(scored.begin(), scored.end(),
-                       [&](const eval::ViewMetrics& v) { return v.name == entry.first; }))
-        names.push_back(entry.first);
+                       [&](const eval::ViewMetrics& v) { return v.name == name; }))
+        names.push_back(name);
     return names;
   }
 
@@ -114,10 +132,11 @@ class GroundTruth {
   std::optional<Scene> scene_;
   std::optional<ViewImages> images_;
   std::map<std::string, const Camera*> cameras_;
+  std::vector<std::string> names_;  // in the split's or the folder's order
 };
 
 void run_eval(const EvalArgs& args) {
-  check_rendered_split(args);
+  check_render_record(args);
   SceneArgs scene_args;
   scene_args.options.downscale = args.downscale;
   scene_args.background = args.background;
@@ -139,9 +158,10 @@ void run_eval(const EvalArgs& args) {
     if ((i + 1) % 25 == 0 || i + 1 == files.size())
       fmt::print("evaluated {}/{} views\n", i + 1, files.size());
   }
-  const std::filesystem::path base = args.output.empty()
-                                         ? std::filesystem::path(args.renders) / "metrics"
-                                         : std::filesystem::path(args.output);
+  std::filesystem::path base = args.output.empty() ? std::filesystem::path(args.renders) / "metrics"
+                                                   : std::filesystem::path(args.output);
+  // A folder given as the output holds the report under the default name, not as ".json".
+  if (!base.has_filename() || std::filesystem::is_directory(base)) base /= "metrics";
   // A mean over part of a split is not the split's score: say so, in the report and next to the
   // numbers.
   report.unscored = truth.unscored(report.views);
@@ -149,8 +169,8 @@ void run_eval(const EvalArgs& args) {
   eval::write_report(base, report);
   if (!unscored.empty())
     fmt::print(
-        "note: {} views of the {} split have no render and are not in the mean: {}{}\n",
-        unscored.size(), args.split,
+        "note: {} views of {} have no render and are not in the mean: {}{}\n", unscored.size(),
+        is_scene(args.ground_truth) ? "the " + args.split + " split" : args.ground_truth,
         fmt::join(unscored.begin(), unscored.begin() + std::min<size_t>(5, unscored.size()), ", "),
         unscored.size() > 5 ? ", ..." : "");
   const eval::ViewMetrics mean = report.mean();
@@ -174,7 +194,8 @@ void add_eval_command(CLI::App& app) {
       ->required();
   command
       ->add_option("-o,--output", args->output,
-                   "Report path without extension (default <renders>/metrics)")
+                   "Report path without extension, or a folder for metrics.json and .csv "
+                   "(default <renders>/metrics)")
       ->check(kNonEmptyPath);
   command->add_option("--split", args->split, "Scene split to compare with")
       ->check(CLI::IsMember({"train", "test"}))

@@ -324,6 +324,22 @@ TEST(Cli, EvalOfPartOfASplitNamesTheViewsLeftOut) {
   const auto report = nlohmann::json::parse(read_file(dir / "renders" / "metrics.json"));
   EXPECT_EQ(report["unscored_views"], nlohmann::json::array({"r_1"}));
 
+  // The same against a plain folder of images, the report written into a folder given as -o.
+  const std::string truth = (dir / "scene" / "test").string();
+  const CliRun folder = iesrgs("eval --lpips none " + (dir / "renders").string() + " " + truth +
+                               " -o " + (dir / "scores").string() + "/");
+  EXPECT_EQ(folder.status, 0) << folder.output;
+  EXPECT_TRUE(contains(folder.output, "1 views of " + truth + " have no render")) << folder.output;
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir / "scores" / "metrics.json"))["unscored_views"],
+            nlohmann::json::array({"r_1"}));
+
+  // Two renders of one view would count it twice in the mean.
+  write_text(dir / "renders" / "r_0.jpg", "refused before it is decoded");
+  const CliRun twice = iesrgs("eval --lpips none " + (dir / "renders").string() + " " + scene);
+  EXPECT_EQ(twice.status, 1);
+  EXPECT_TRUE(contains(last_line(twice.output), "r_0.jpg and r_0.png are both renders of view r_0"))
+      << twice.output;
+
   const CliRun nowhere =
       iesrgs("eval --lpips none " + (dir / "renders").string() + " " + (dir / "none").string());
   EXPECT_EQ(nowhere.status, 1);
