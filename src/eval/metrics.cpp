@@ -29,8 +29,17 @@ nlohmann::json to_json(const ViewMetrics& m) {
   return json;
 }
 
+// A view's name as one CSV field (RFC 4180): quoted, quotes doubled, when it holds a comma, a
+// quote or a line break, which file names may.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
 std::string csv_row(const ViewMetrics& m) {
-  return fmt::format("{},{:.6f},{:.6f},{}\n", m.name, m.psnr, m.ssim,
+  return fmt::format("{},{:.6f},{:.6f},{}\n", csv_field(m.name), m.psnr, m.ssim,
                      m.lpips ? fmt::format("{:.6f}", *m.lpips) : "");
 }
 

@@ -75,5 +75,16 @@ TEST(Metrics, ReportWritesAnInfinitePsnrAsNullInJsonAndInfInCsv) {
             "mean,inf,0.750000,\n");
 }
 
+// File names may hold commas and quotes; each row keeps four fields.
+TEST(Metrics, CsvQuotesViewNamesThatNeedIt) {
+  testing::TempDir dir;
+  MetricsReport report;
+  report.views = {{"a,b", 20, 0.5, std::nullopt}, {"say \"hi\"", 20, 0.5, std::nullopt}};
+  write_report(dir / "metrics", report);
+  EXPECT_EQ(read_file(dir / "metrics.csv"),
+            "name,psnr,ssim,lpips\n\"a,b\",20.000000,0.500000,\n"
+            "\"say \"\"hi\"\"\",20.000000,0.500000,\nmean,20.000000,0.500000,\n");
+}
+
 }  // namespace
 }  // namespace iesrgs::eval
