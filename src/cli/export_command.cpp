@@ -34,13 +34,14 @@ void run_export(const ExportArgs& args) {
   const SplatCloud cloud = read_model(model);
   // An empty .splat is an empty file, which no reader can tell from a damaged one.
   if (cloud.size() == 0) fail_file(model, "holds no Gaussians: nothing to export");
+  size_t written = cloud.size();
   if (format == ".splat")
-    write_splat(output, cloud);
+    written = write_splat(output, cloud);
   else if (format == ".spz")
-    write_spz(output, cloud);
+    written = write_spz(output, cloud);
   else
     write_ply_filter_baked(output, cloud);
-  fmt::print("wrote {} Gaussians to {} ({} bytes)\n", cloud.size(), output.string(),
+  fmt::print("wrote {} Gaussians to {} ({} bytes)\n", written, output.string(),
              std::filesystem::file_size(output));
 }
 

@@ -74,13 +74,14 @@ void append_record(std::string& bytes, const SplatCloud& cloud, size_t i) {
 
 }  // namespace
 
-void write_splat(const std::filesystem::path& path, const SplatCloud& cloud) {
+size_t write_splat(const std::filesystem::path& path, const SplatCloud& cloud) {
   static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, ".splat floats are little-endian");
   const SplatCloud baked = viewer_cloud(cloud, path);
   std::string bytes;
   bytes.reserve(baked.size() * kSplatRecordBytes);
   for (size_t i : most_visible_first(baked)) append_record(bytes, baked, i);
   write_file_atomically(path, bytes);
+  return baked.size();
 }
 
 SplatCloud parse_splat(std::string_view bytes, const std::filesystem::path& name) {

@@ -16,7 +16,8 @@ constexpr size_t kSplatRecordBytes = 32;
 // quaternion w x y z (4 uint8: q * 128 + 128), the most visible Gaussians first (largest
 // prod(scale) * opacity), as the viewers stream them. Mip-Splatting's 3D filter is baked in
 // first. Written atomically; throws Error naming the file for a malformed or non-finite cloud.
-void write_splat(const std::filesystem::path& path, const SplatCloud& cloud);
+// Returns how many Gaussians it wrote (viewer_cloud leaves out those no viewer can draw).
+size_t write_splat(const std::filesystem::path& path, const SplatCloud& cloud);
 
 // A .splat file as a cloud of SH degree 0, drawn as the viewers draw it (classic 2D dilation, no
 // 3D filter). Colour and opacity come back to within their 8-bit steps and rotations to within

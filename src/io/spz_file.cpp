@@ -321,10 +321,11 @@ SplatCloud decode_streams(const SpzHeader& h, const std::string& streams) {
 
 }  // namespace
 
-void write_spz(const std::filesystem::path& path, const SplatCloud& cloud) {
+size_t write_spz(const std::filesystem::path& path, const SplatCloud& cloud) {
   const SplatCloud baked = viewer_cloud(cloud, path);
   const uint8_t flags = cloud.antialiased ? kAntialiased : 0;
   write_file_atomically(path, gzip(encode(baked, flags, fractional_bits(baked, path)), path));
+  return baked.size();
 }
 
 SplatCloud parse_spz(std::string_view bytes, const std::filesystem::path& name) {

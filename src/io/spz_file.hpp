@@ -16,7 +16,8 @@ namespace iesrgs {
 // .ply's, unconverted, as the reference ply_to_spz writes them. The 3D filter is baked in first
 // and, for an antialiased cloud, the "antialiased" flag tells the viewer to use Mip-Splatting's
 // 2D filter. Written atomically; throws Error naming the file for a malformed or non-finite cloud.
-void write_spz(const std::filesystem::path& path, const SplatCloud& cloud);
+// Returns how many Gaussians it wrote (viewer_cloud leaves out those no viewer can draw).
+size_t write_spz(const std::filesystem::path& path, const SplatCloud& cloud);
 
 // Reads versions 2 and 3 (gzip) and 4 (one zstd stream per attribute) into raw 3DGS parameters:
 // logit opacities (bytes 0 and 255 half a quantization step inside (0, 1), where they would be

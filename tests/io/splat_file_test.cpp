@@ -87,7 +87,7 @@ TEST(SplatFile, UndrawableGaussiansAreLeftOutAndMalformedCloudsWriteNothing) {
   TempDir dir;
   SplatCloud cloud = two_gaussians();
   cloud.log_scales[4] = NAN;
-  write_splat(dir / "nan.splat", cloud);
+  EXPECT_EQ(write_splat(dir / "nan.splat", cloud), 1u);
   EXPECT_EQ(decode(read_file(dir / "nan.splat")).size(), 1u);
   cloud = two_gaussians();
   cloud.log_scales[0] = 100;  // finite, but not once exponentiated into a float
