@@ -4,9 +4,11 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <string_view>
 
 #include "core/error.hpp"
 #include "core/paths.hpp"
@@ -25,7 +27,10 @@ void require_readable(const fs::path& path) {
 }
 
 std::string decode_problem() {
+  const int open_error = errno;  // what stb's fopen left, before anything here changes it
   const char* reason = stbi_failure_reason();
+  if (reason && std::string_view(reason) == "can't fopen")
+    return std::string("cannot be opened: ") + std::strerror(open_error);
   return std::string("not a readable PNG/JPEG (") + (reason ? reason : "unknown reason") + ")";
 }
 
@@ -88,7 +93,10 @@ std::string encode_png(const fs::path& path, const uint8_t* samples, int width, 
 
 std::vector<fs::path> image_files_in(const fs::path& folder) {
   std::vector<fs::path> images;
-  for (const fs::directory_entry& entry : fs::directory_iterator(folder))
+  std::error_code ec;
+  fs::directory_iterator entries(folder, ec);
+  if (ec) fail_file(folder, "cannot be read: " + ec.message());
+  for (const fs::directory_entry& entry : entries)
     if (entry.is_regular_file() && is_image_file(entry.path())) images.push_back(entry.path());
   if (images.empty()) fail_file(folder, "no PNG or JPEG images in this folder");
   std::sort(images.begin(), images.end());
