@@ -34,6 +34,9 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
                                const std::function<gs::GaussianModel()>& initial_model) {
   const fs::path dir = setup.output_dir;
   const nlohmann::json identity = stage_identity(params, config);
+  // The recorded time of a finished stage whose model is made again from its final checkpoint:
+  // the later stages that learnt from the model are keyed on it.
+  std::optional<double> finished_seconds;
   if (model_finished(dir, identity)) {
     try {
       gs::GaussianModel model = gs::model_from_splat_cloud(read_ply(train::model_path(dir)));
@@ -42,6 +45,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
     } catch (const Error& e) {
       // Damaged since it was written: made again from the final checkpoint, or trained again.
       fmt::print("{}: {}; writing it again\n", name, e.what());
+      finished_seconds = stage_seconds(dir);
     }
   }
   remove_stale_temporaries(dir);  // a killed run's half-written checkpoint, say
@@ -61,17 +65,21 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
       train::remove_earlier_run(dir);
     }
   }
-  if (!trainer) trainer.emplace(config, std::move(setup), initial_model());
+  if (!trainer) {
+    finished_seconds.reset();  // a new model, trained from the start
+    trainer.emplace(config, std::move(setup), initial_model());
+  }
   const train::TrainSummary summary = trainer->run();
   if (summary.interrupted)
     throw Interrupted(
         fmt::format("{} stopped at iteration {}; run the same command again to resume", name,
                     summary.iterations));
   train::write_point_clouds(dir, trainer->model());
-  record_stage(dir, identity, true, summary.seconds);
+  const double seconds = finished_seconds.value_or(summary.seconds);
+  record_stage(dir, identity, true, seconds);
   fmt::print("{}: {} Gaussians after {} ({:.2f} it/s)\n", name, summary.gaussians,
-             format_duration(summary.seconds), summary.iterations_per_second);
-  return {trainer->model(), summary.seconds, false};
+             format_duration(seconds), summary.iterations_per_second);
+  return {trainer->model(), seconds, false};
 }
 
 bool training_stage_current(const fs::path& dir, const nlohmann::json& params,

@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "pipeline/stage_record.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 #include "synth/dataset_writer.hpp"
@@ -111,7 +112,8 @@ TEST(TrainingStage, UnresumableCheckpointTrainsTheStageAgain) {
 }
 
 // A finished model damaged since it was written comes back from the final checkpoint, without
-// training; with the checkpoint gone too, the stage trains again.
+// training and with its recorded time, on which later stages are keyed; with the checkpoint gone
+// too, the stage trains again.
 TEST(TrainingStage, DamagedFinishedModelIsWrittenAgain) {
   TempDir dir;
   const StageRun run = tiny_stage(dir / "scene", dir / "stage");
@@ -126,6 +128,8 @@ TEST(TrainingStage, DamagedFinishedModelIsWrittenAgain) {
   EXPECT_FALSE(restored.cached);
   EXPECT_EQ(read_file(ply), intact);
   EXPECT_EQ(restored.model.size(), first.model.size());
+  EXPECT_EQ(restored.seconds, first.seconds);
+  EXPECT_EQ(stage_seconds(dir / "stage"), first.seconds);
 
   write_file_atomically(ply, intact.substr(0, 300));
   std::filesystem::remove(train::checkpoint_path(dir / "stage"));
