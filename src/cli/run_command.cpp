@@ -149,7 +149,9 @@ void add_pipeline_command(CLI::App& app, const std::string& name, const std::str
     for (size_t i = internal_options; i < options.size(); ++i)
       options[i]->group("Options of the other stages (accepted, unused here)");
   }
-  command->add_option("--seed", args->seed, "Random seed of both trainings")->capture_default_str();
+  command->add_option("--seed", args->seed, "Random seed of both trainings")
+      ->capture_default_str()
+      ->check(kNonNegative);
   add_device_option(*command, args->device);
   command->callback([args, only] { run_pipeline(*args, only); });
 }

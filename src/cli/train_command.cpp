@@ -46,8 +46,16 @@ train::TrainConfig requested_config(const TrainArgs& args,
       base && !args.preset_given ? *base : train::make_preset(args.preset, args.iterations);
   if (base && !args.preset_given && args.iterations > 0)
     train::rescale_schedule(config, args.iterations);
-  if (!args.config_file.empty())
-    train::apply_json(config, read_json_file(args.config_file), args.config_file);
+  if (!args.config_file.empty()) {
+    const nlohmann::json file = read_json_file(args.config_file);
+    // The preset names where the schedule came from: a file's own would relabel this one's.
+    if (file.is_object() && file.contains("preset") && file["preset"] != config.preset)
+      fail_file(args.config_file,
+                fmt::format("its preset {} is not this run's \"{}\": the preset is chosen with "
+                            "--preset, which also sets its schedule",
+                            file["preset"].dump(), config.preset));
+    train::apply_json(config, file, args.config_file);
+  }
   if (args.views_per_iteration > 0) config.views_per_iteration = args.views_per_iteration;
   if (args.seed >= 0) config.seed = uint64_t(args.seed);
   for (const std::string& assignment : args.assignments)
@@ -163,7 +171,7 @@ void add_train_command(CLI::App& app) {
   defines_run(command->add_option("--mv", args->views_per_iteration,
                                   "Views per iteration (multi-view regulation K; 1 = plain 3DGS)"))
       ->check(kPositive);
-  defines_run(command->add_option("--seed", args->seed, "Random seed"));
+  defines_run(command->add_option("--seed", args->seed, "Random seed"))->check(kNonNegative);
   defines_run(
       command->add_option("--config", args->config_file, "JSON file of training parameters"));
   defines_run(command->add_option(

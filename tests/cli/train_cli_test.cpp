@@ -291,10 +291,21 @@ TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {
   EXPECT_TRUE(contains(last_line(edited.output),
                        "config.json: invalid training config: max_sh_degree must be 0..3"))
       << edited.output;
+  // A config file naming another preset would relabel the run's schedule.
+  write_file_atomically(dir / "paper.json", R"({"preset": "paper", "seed": 3})");
+  const CliRun relabel = iesrgs("train " + scene + " -o " + (dir / "d").string() + " --config " +
+                                (dir / "paper.json").string());
+  EXPECT_EQ(relabel.status, 1);
+  EXPECT_TRUE(contains(last_line(relabel.output),
+                       "paper.json: its preset \"paper\" is not this run's \"cpu\""))
+      << relabel.output;
   // Out-of-range numbers are refused before any work, in words.
   const CliRun none = iesrgs("train " + scene + " -o " + (dir / "c").string() + " --iterations 0");
   EXPECT_NE(none.status, 0);
   EXPECT_TRUE(contains(none.output, "--iterations: must be greater than 0, got 0")) << none.output;
+  const CliRun negative = iesrgs("train " + scene + " -o " + (dir / "c").string() + " --seed -5");
+  EXPECT_NE(negative.status, 0);
+  EXPECT_TRUE(contains(negative.output, "--seed: must be at least 0, got -5")) << negative.output;
   const CliRun bright =
       iesrgs("train " + scene + " -o " + (dir / "c").string() + " --background 2,0,0.5");
   EXPECT_EQ(bright.status, 1);
