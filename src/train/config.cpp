@@ -69,6 +69,11 @@ void read_field(const nlohmann::json& value, T& field, const std::string& key,
                                 value.get<int64_t>() <= int64_t(std::numeric_limits<T>::max());
     if (!fits) fail("{}: \"{}\" is out of range ({})", origin, key, value.dump());
   }
+  if constexpr (std::is_floating_point_v<T>) {
+    // Beyond the field's range it would hold an infinity, which config.json cannot store.
+    if (!(std::abs(value.get<double>()) <= double(std::numeric_limits<T>::max())))
+      fail("{}: \"{}\" is out of range ({})", origin, key, value.dump());
+  }
   field = value.get<T>();
 }
 

@@ -77,6 +77,11 @@ TEST(TrainConfig, BadInputNamesTheProblem) {
               apply_assignment(c, "random_points=4294967496");
             }).find("\"random_points\" is out of range (4294967496)"),
             std::string::npos);
+  // Beyond a float, the field would hold an infinity that config.json stores as null.
+  EXPECT_NE(error_message([&] {
+              apply_assignment(c, "max_screen_size=1e39");
+            }).find("\"max_screen_size\" is out of range (1e+39)"),
+            std::string::npos);
   // The preset is a record of where the schedule came from, set with --preset.
   EXPECT_NE(error_message([&] { apply_assignment(c, "preset=paper"); }).find("--preset"),
             std::string::npos);
