@@ -10,17 +10,18 @@ namespace iesrgs::gs {
 namespace {
 
 // Points bucketed by cell: cell c holds order[start[c] .. start[c + 1]).
+// In double: the spread of float coordinates near the float limit overflows a float.
 struct PointGrid {
-  std::array<float, 3> origin{};
-  float cell = 1;
+  std::array<double, 3> origin{};
+  double cell = 1;
   std::array<int, 3> dims{1, 1, 1};
   std::vector<int> start, order;
 
   std::array<int, 3> cell_of(const float* p) const {
     std::array<int, 3> c;
-    // Clamped as floats: an outlier's cell number need not fit an int.
+    // Clamped before the conversion: an outlier's cell number need not fit an int.
     for (int a = 0; a < 3; ++a)
-      c[a] = int(std::clamp((p[a] - origin[a]) / cell, 0.f, float(dims[a] - 1)));
+      c[a] = int(std::clamp((p[a] - origin[a]) / cell, 0.0, double(dims[a] - 1)));
     return c;
   }
   int index(int x, int y, int z) const { return (z * dims[1] + y) * dims[0] + x; }
@@ -32,7 +33,7 @@ struct PointGrid {
 // cloud filling its box; flatter clouds get more per cell.
 PointGrid build_grid(const float* points, int count) {
   PointGrid grid;
-  std::array<float, 3> hi;
+  std::array<double, 3> hi;
   std::vector<float> axis(count);
   const int low_rank = count / 100, high_rank = count - 1 - count / 100;
   for (int a = 0; a < 3; ++a) {
@@ -42,9 +43,9 @@ PointGrid build_grid(const float* points, int count) {
     std::nth_element(axis.begin() + low_rank, axis.begin() + high_rank, axis.end());
     hi[a] = axis[high_rank];
   }
-  const float span = std::max({hi[0] - grid.origin[0], hi[1] - grid.origin[1],
-                               hi[2] - grid.origin[2], std::numeric_limits<float>::min()});
-  grid.cell = span / std::max(1.f, std::cbrt(float(count)));
+  const double span = std::max({hi[0] - grid.origin[0], hi[1] - grid.origin[1],
+                                hi[2] - grid.origin[2], double(std::numeric_limits<float>::min())});
+  grid.cell = span / std::max(1.0, std::cbrt(double(count)));
   for (int a = 0; a < 3; ++a) grid.dims[a] = int((hi[a] - grid.origin[a]) / grid.cell) + 1;
 
   const int cells = grid.dims[0] * grid.dims[1] * grid.dims[2];
@@ -116,7 +117,7 @@ std::vector<float> mean_knn_squared_distance(const float* points, int count, int
     // k-th best is within that bound.
     for (int ring = 0; ring <= max_ring; ++ring) {
       scan_ring(grid, points, i, home, ring, best);
-      const float reach = ring * grid.cell;
+      const double reach = ring * grid.cell;
       if (best.full() && best.d2[wanted - 1] <= reach * reach) break;
     }
     float sum = 0;

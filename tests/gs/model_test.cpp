@@ -63,6 +63,17 @@ TEST(GaussianModel, NearestNeighboursOfTinyClouds) {
   EXPECT_TRUE(mean_knn_squared_distance(two, 0).empty());
 }
 
+// Points near the float limit: their spread overflows a float, which must not size the grid.
+TEST(GaussianModel, NearestNeighboursOfPointsNearTheFloatLimit) {
+  std::vector<float> points;
+  for (int i = 0; i < 300; ++i)
+    for (int a = 0; a < 3; ++a)
+      points.push_back((i * 7 + a * 13) % 100 < 50 ? -1.75e38f : 1.75e38f);
+  const std::vector<float> distances = mean_knn_squared_distance(points.data(), 300);
+  ASSERT_EQ(distances.size(), 300u);
+  EXPECT_EQ(distances[0], 0.f);  // its three nearest neighbours share its corner
+}
+
 TEST(GaussianModel, InitializesFromSfmPointsAs3dgs) {
   PointCloud cloud;
   // Four corners of a unit square plus a duplicate-free far point: 3 nearest known by hand.
