@@ -82,8 +82,8 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
 
 void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianModel& model) {
   const SplatCloud cloud = gs::to_splat_cloud(model);
-  write_ply(model_path(dir), cloud);
   write_ply_filter_baked(dir / "point_cloud_filter_baked.ply", cloud);
+  write_ply(model_path(dir), cloud);
 }
 
 bool remove_earlier_run(const std::filesystem::path& dir) {

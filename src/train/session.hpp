@@ -41,7 +41,8 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
 
 // <dir>/point_cloud.ply (3DGS layout plus the Mip-Splatting filter_3D property) and
 // <dir>/point_cloud_filter_baked.ply (the filter folded into scale and opacity, for viewers that
-// do not know it), both written atomically.
+// do not know it), both written atomically; the model last, since it tells a finished training
+// (a process killed between the two leaves a training to resume).
 void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianModel& model);
 
 // Removes what an earlier training left in `dir` (checkpoint, log, point clouds, summary), before
