@@ -73,9 +73,23 @@ double psnr(const torch::Tensor& image, const torch::Tensor& target) {
   return eval::psnr_from_mse(std::max(mse, 1e-20));
 }
 
+bool finite(const torch::Tensor& values) {
+  return !values.defined() || torch::isfinite(values).all().item<bool>();
+}
+
 bool all_finite(const gs::GaussianModel& model) {
   for (int p = 0; p < gs::kParamCount; ++p)
-    if (!torch::isfinite(model.param(gs::Param(p))).all().item<bool>()) return false;
+    if (!finite(model.param(gs::Param(p)))) return false;
+  return true;
+}
+
+// Everything a checkpoint restores that the next step computes with.
+bool restored_state_finite(const gs::GaussianModel& model, const gs::GaussianOptimizer& optimizer) {
+  if (!all_finite(model) || !finite(model.filter_3d)) return false;
+  for (int p = 0; p < gs::kParamCount; ++p) {
+    const gs::AdamMoments& moments = optimizer.moments(gs::Param(p));
+    if (!finite(moments.first) || !finite(moments.second)) return false;
+  }
   return true;
 }
 
@@ -173,7 +187,8 @@ void Trainer::load_checkpoint() {
   gs::load_training_state(path, model_, *optimizer_, stats_, &extras);  // onto the CPU
   // A model that diverged is never saved, so these were damaged or written by another program;
   // training from them would only diverge again, blaming the images.
-  if (!all_finite(model_)) fail_file(path, "holds non-finite parameters (not saved by training)");
+  if (!restored_state_finite(model_, *optimizer_))
+    fail_file(path, "holds non-finite parameters or optimizer moments (not saved by training)");
   place_on(model_, device_);
   optimizer_->to(device_);
   stats_.to(device_);
@@ -300,6 +315,12 @@ void Trainer::densify(int64_t iteration) {
       const gs::DensifyCounts counts =
           gs::densify_and_prune(model_, *optimizer_, stats_, options, setup_.scene_extent);
       if (counts.held_back > 0) warn_memory_cap(iteration, options.max_gaussians, counts.held_back);
+      // An empty model would train on to an empty point cloud, which no command reads.
+      if (model_.size() == 0)
+        fail(
+            "iteration {}: densification pruned every Gaussian (min_opacity {}, max_world_size "
+            "{}, max_screen_size {}): nothing is left to train",
+            iteration, c.min_opacity, c.max_world_size, c.max_screen_size);
       gs::update_filter_3d(model_, train_cameras_);
     }
     const bool white = setup_.background == std::array<float, 3>{1, 1, 1};

@@ -257,38 +257,44 @@ TEST_F(TrainerTest, TamperedCheckpointsAreRefused) {
   const std::filesystem::path file = out / "checkpoint.pt";
   const std::string original = read_file(file);
   // The error of resuming after `tamper` changed the stored state.
-  const auto resume_error =
-      [&](const std::function<void(gs::GaussianModel&, gs::CheckpointExtras&)>& tamper) {
-        gs::GaussianModel model;
-        gs::GaussianOptimizer optimizer(initial(), {}, 1);
-        gs::DensifyStats stats;
-        gs::CheckpointExtras extras{
-            {"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}}, {"background", {}}};
-        gs::load_training_state(file, model, optimizer, stats, &extras);
-        tamper(model, extras);
-        gs::save_training_state(file, model, optimizer, stats, extras);
-        const std::string message = error_message([&] { Trainer::resumed(c, setup(out.path())); });
-        write_file_atomically(file, original);
-        EXPECT_TRUE(testing::contains(message, file.string() + ": ")) << message;
-        return message;
-      };
+  const auto resume_error = [&](const std::function<void(gs::GaussianModel&, gs::GaussianOptimizer&,
+                                                         gs::CheckpointExtras&)>& tamper) {
+    gs::GaussianModel model;
+    gs::GaussianOptimizer optimizer(initial(), {}, 1);
+    gs::DensifyStats stats;
+    gs::CheckpointExtras extras{
+        {"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}}, {"background", {}}};
+    gs::load_training_state(file, model, optimizer, stats, &extras);
+    tamper(model, optimizer, extras);
+    gs::save_training_state(file, model, optimizer, stats, extras);
+    const std::string message = error_message([&] { Trainer::resumed(c, setup(out.path())); });
+    write_file_atomically(file, original);
+    EXPECT_TRUE(testing::contains(message, file.string() + ": ")) << message;
+    return message;
+  };
   using Extras = gs::CheckpointExtras;
   EXPECT_TRUE(testing::contains(
-      resume_error([](auto&, Extras& e) { e["iteration"] = torch::tensor(int64_t(5)); }),
+      resume_error([](auto&, auto&, Extras& e) { e["iteration"] = torch::tensor(int64_t(5)); }),
       "stored at iteration 5, outside the 0..4 iterations"));
-  EXPECT_TRUE(testing::contains(resume_error([](auto&, Extras& e) {
+  EXPECT_TRUE(testing::contains(resume_error([](auto&, auto&, Extras& e) {
                                   e["iteration"] = torch::tensor({1, 2});
                                 }),
                                 "iteration holds 2 values, not one"));
   EXPECT_TRUE(testing::contains(
-      resume_error([](auto&, Extras& e) { e["background"] = torch::tensor({0.5f}); }),
+      resume_error([](auto&, auto&, Extras& e) { e["background"] = torch::tensor({0.5f}); }),
       "trained over the background 0.5, not 1,1,1"));
+  EXPECT_TRUE(testing::contains(resume_error([](auto&, auto&, Extras& e) {
+                                  e["torch_rng"] = torch::zeros({3}, torch::kUInt8);
+                                }),
+                                "not a readable training checkpoint ("));
   EXPECT_TRUE(testing::contains(
-      resume_error([](auto&, Extras& e) { e["torch_rng"] = torch::zeros({3}, torch::kUInt8); }),
-      "not a readable training checkpoint ("));
-  EXPECT_TRUE(testing::contains(
-      resume_error([](gs::GaussianModel& m, Extras&) { m.means.data()[0][0] = NAN; }),
+      resume_error([](gs::GaussianModel& m, auto&, Extras&) { m.means.data()[0][0] = NAN; }),
       "holds non-finite parameters"));
+  EXPECT_TRUE(testing::contains(resume_error([](auto&, gs::GaussianOptimizer& o, Extras&) {
+                                  torch::Tensor first = o.moments(gs::Param::Means).first;
+                                  first.view(-1)[0] = NAN;  // shares the optimizer's storage
+                                }),
+                                "non-finite parameters or optimizer moments"));
   write_file_atomically(out / "cameras.json", "[{\"id\": 0,");
   EXPECT_TRUE(testing::contains(error_message([&] { Trainer::resumed(c, setup(out.path())); }),
                                 "cameras.json: damaged (not valid JSON)"));
@@ -329,6 +335,18 @@ TEST_F(TrainerTest, EmptyStartingPlyIsAClearError) {
   const std::string message =
       error_message([&] { initial_model(*scene_, config(), dir / "empty.ply"); });
   EXPECT_NE(message.find("empty.ply: has no Gaussians to start training from"), std::string::npos)
+      << message;
+}
+
+// Pruning every Gaussian would end in an empty point cloud, which no command reads.
+TEST_F(TrainerTest, PruningEveryGaussianStopsTraining) {
+  TempDir dir;
+  TrainConfig c = config();
+  c.min_opacity = 0.999;  // above every starting opacity
+  Trainer trainer(c, setup(dir.path()), initial());
+  const std::string message = error_message([&] { trainer.run(); });
+  EXPECT_NE(message.find("densification pruned every Gaussian (min_opacity 0.999"),
+            std::string::npos)
       << message;
 }
 
