@@ -210,7 +210,8 @@ void Pipeline::check_cached_inputs() const {
   if (any_row(Source::SuperResolved))
     require(external_stage_current(lr_scene_, *lr_images_, o_.external, o_.output / "external"),
             o_.output / "external", "external",
-            fmt::format("iesrgs external --downscale {} -o {} or iesrgs run", lr_scene_.downscale,
+            fmt::format("iesrgs external {} --downscale {} --scale {} -o {} or iesrgs run",
+                        o_.scene.string(), lr_scene_.downscale, o_.scale,
                         (o_.output / "external").string()));
   if (rows_use_internal_references())
     require(internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
