@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <new>
 
 namespace iesrgs {
@@ -38,6 +39,10 @@ std::string current_exception_message() {
     const std::string line = torch_error_line(e);
     const std::string oom = allocation_failure(line);
     return oom.empty() ? line : oom;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // "filesystem error: status: Permission denied [a/b]" as the other errors say it: the file,
+    // then the problem.
+    return e.path1().empty() ? e.what() : e.path1().string() + ": " + e.code().message();
   } catch (const std::exception& e) {
     return e.what();
   } catch (...) {

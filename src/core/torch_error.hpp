@@ -10,8 +10,8 @@ namespace iesrgs {
 std::string torch_error_line(const c10::Error& error);
 
 // One line for the exception being handled (call it inside a catch block): "out of memory",
-// with the size LibTorch asked for when it says, for an allocation that failed; the message of
-// any other exception.
+// with the size LibTorch asked for when it says, for an allocation that failed; "PATH: reason"
+// for a std::filesystem error; the message of any other exception.
 std::string current_exception_message();
 
 }  // namespace iesrgs

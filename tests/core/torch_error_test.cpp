@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <new>
+#include <system_error>
 
 #include "core/error.hpp"
 
@@ -44,6 +46,13 @@ TEST(TorchError, FailedLibTorchAllocationIsOutOfMemoryWithItsSize) {
       "12582912 bytes. Error code 12 (Cannot allocate memory)";
   EXPECT_EQ(message_of([&] { throw torch_error(smaller); }),
             "out of memory (LibTorch asked for 12.0 MiB)");
+}
+
+// Said as the other errors are: the file, then the problem.
+TEST(TorchError, FilesystemErrorsNameThePathFirst) {
+  const std::filesystem::filesystem_error denied(
+      "status", "run/render.json", std::make_error_code(std::errc::permission_denied));
+  EXPECT_EQ(message_of([&] { throw denied; }), "run/render.json: Permission denied");
 }
 
 TEST(TorchError, OtherExceptionsKeepTheirMessage) {
