@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -116,6 +117,21 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
                 .status,
             0);
   EXPECT_TRUE(std::filesystem::exists(dir / "keep.png"));
+
+  // Views of other sizes than the first are checked too: here a nerfstudio frame's own width
+  // (its training views are r_1 to r_5, every 8th frame by name being a test view).
+  std::filesystem::copy(dir / "scene", dir / "sizes", std::filesystem::copy_options::recursive);
+  auto layout = nlohmann::json::parse(read_file(dir / "sizes" / "transforms_train.json"));
+  for (const char* split : {"transforms_train.json", "transforms_test.json"})
+    std::filesystem::remove(dir / "sizes" / split);
+  layout["frames"][2]["w"] = 40000;
+  write_file_atomically(dir / "sizes" / "transforms.json", layout.dump());
+  const CliRun wide = iesrgs("render " + out + " " + (dir / "sizes").string() + " -o " +
+                             (dir / "wide").string() + " --split train --scale 2");
+  EXPECT_EQ(wide.status, 1);
+  EXPECT_TRUE(contains(last_line(wide.output), "--scale 2: view r_2 would be 80000x64 pixels"))
+      << wide.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "wide"));
 
   // eval scores renders against the split they were made of, which render.json records.
   const CliRun path_scored = iesrgs("eval " + (dir / "orbit").string() + " " + scene);
