@@ -41,12 +41,10 @@ std::vector<std::filesystem::path> render_files(std::filesystem::path dir) {
   if (!std::filesystem::is_directory(dir)) fail_file(dir, "is not a folder of rendered images");
   std::vector<std::filesystem::path> files = image_files_in(dir);
   // a.png and a.jpg would both be scored as view a, which would count twice in the mean.
-  std::map<std::string, std::filesystem::path> by_stem;
-  for (const std::filesystem::path& file : files)
-    if (const auto [it, added] = by_stem.emplace(file.stem().string(), file); !added)
-      fail_file(dir,
-                fmt::format("{} and {} are both renders of view {}; keep one",
-                            it->second.filename().string(), file.filename().string(), it->first));
+  if (const auto shared = first_shared_stem(files))
+    fail_file(dir, fmt::format("{} and {} are both renders of view {}; keep one",
+                               shared->first.filename().string(),
+                               shared->second.filename().string(), shared->first.stem().string()));
   return files;
 }
 

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -49,16 +48,15 @@ struct Job {
 std::vector<Job> folder_jobs(const fs::path& folder, const fs::path& out) {
   if (fs::exists(out) && !fs::is_directory(out))
     fail_file(out, "is a file, but the input is a folder");
-  std::vector<Job> jobs;
-  for (const fs::path& image : image_files_in(folder))
-    jobs.push_back({image, out / image.stem().concat(".png")});
+  const std::vector<fs::path> images = image_files_in(folder);
   // a.png and a.jpg would both become a.png, the second overwriting the first.
-  std::map<fs::path, fs::path> inputs;
-  for (const Job& job : jobs)
-    if (const auto [it, added] = inputs.emplace(job.output, job.input); !added)
-      fail_file(folder, fmt::format("{} and {} would both be upscaled to {}; rename one",
-                                    it->second.filename().string(), job.input.filename().string(),
-                                    job.output.string()));
+  if (const auto shared = first_shared_stem(images))
+    fail_file(folder,
+              fmt::format("{} and {} would both be upscaled to {}; rename one",
+                          shared->first.filename().string(), shared->second.filename().string(),
+                          (out / shared->first.stem().concat(".png")).string()));
+  std::vector<Job> jobs;
+  for (const fs::path& image : images) jobs.push_back({image, out / image.stem().concat(".png")});
   return jobs;
 }
 

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <memory>
 #include <string_view>
 
@@ -101,6 +102,14 @@ std::vector<fs::path> image_files_in(const fs::path& folder) {
   if (images.empty()) fail_file(folder, "no PNG or JPEG images in this folder");
   std::sort(images.begin(), images.end());
   return images;
+}
+
+std::optional<std::pair<fs::path, fs::path>> first_shared_stem(const std::vector<fs::path>& files) {
+  std::map<fs::path, fs::path> by_stem;
+  for (const fs::path& file : files)
+    if (const auto [it, added] = by_stem.emplace(file.stem(), file); !added)
+      return std::make_pair(it->second, file);
+  return std::nullopt;
 }
 
 ImageHeader read_image_header(const fs::path& path) {

@@ -2,6 +2,8 @@
 // 8-bit and float images (interleaved HWC) with PNG / JPEG decoding and atomic PNG writing.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
+#include <utility>
 #include <vector>
 
 namespace iesrgs {
@@ -29,6 +31,11 @@ struct ImageHeader {
 // The PNG and JPEG files directly inside `folder`, in name order; throws Error naming the folder
 // when it holds none.
 std::vector<std::filesystem::path> image_files_in(const std::filesystem::path& folder);
+
+// The first two of `files` that share a stem (a.png, a.jpg), the earlier first: they would stand
+// for one view, or be written to one output. None when every stem differs.
+std::optional<std::pair<std::filesystem::path, std::filesystem::path>> first_shared_stem(
+    const std::vector<std::filesystem::path>& files);
 
 // Reads only the header; throws Error naming the file when it is missing or not an image.
 ImageHeader read_image_header(const std::filesystem::path& path);
