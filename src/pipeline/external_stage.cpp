@@ -41,7 +41,7 @@ std::string stage_identity(const ExternalOptions& o) {
   return fmt::format("sr={} x{} tile={}/{} weights={} | depth={} weights={}", o.sr_model, o.scale,
                      o.tiles.tile, o.tiles.overlap, sr_weights_digest(o), o.depth_model,
                      // Without a depth model its weights are unused: naming them changes nothing.
-                     o.depth_model == "none" ? "-" : file_digest(o.depth_weights));
+                     file_digest(o.depth_model == "none" ? fs::path() : o.depth_weights));
 }
 
 std::string view_fingerprint(const std::string& stage, const ViewImages& images,
