@@ -144,12 +144,12 @@ void run_render(const RenderArgs& args) {
   write_file_atomically(record, report.dump(2) + "\n");
   const double seconds =
       pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
+  const double fps = pipeline::frames_per_second(seconds);
   report["seconds_per_view"] = seconds;
-  report["fps"] = seconds > 0 ? 1.0 / seconds : 0.0;
+  report["fps"] = fps;
   report["finished"] = true;
   write_file_atomically(record, report.dump(2) + "\n");
-  fmt::print("{:.1f} ms per view ({:.1f} FPS); wrote {}\n", seconds * 1e3,
-             seconds > 0 ? 1.0 / seconds : 0.0, args.output);
+  fmt::print("{:.1f} ms per view ({:.1f} FPS); wrote {}\n", seconds * 1e3, fps, args.output);
 }
 
 }  // namespace

@@ -366,7 +366,7 @@ RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& mo
   result.label = row_label(row);
   result.evaluated = !evaluation.report.views.empty();
   if (result.evaluated) result.mean = evaluation.report.mean();
-  result.fps = evaluation.seconds_per_view > 0 ? 1 / evaluation.seconds_per_view : 0;
+  result.fps = frames_per_second(evaluation.seconds_per_view);
   return result;
 }
 

@@ -47,4 +47,9 @@ double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel
                        const std::vector<Camera>& cameras, const std::array<float, 3>& background,
                        double scale);
 
+// The frame rate of a mean time per view; 0 when nothing was timed.
+inline double frames_per_second(double seconds_per_view) {
+  return seconds_per_view > 0 ? 1 / seconds_per_view : 0;
+}
+
 }  // namespace iesrgs::pipeline

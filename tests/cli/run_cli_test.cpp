@@ -175,6 +175,10 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_EQ(fuse.status, 1);
   EXPECT_TRUE(contains(last_line(fuse.output), "external: the external stage here is missing"))
       << fuse.output;
+  // The hint is a command that makes the stage this run wants: its scene and scale.
+  EXPECT_TRUE(contains(
+      fuse.output, "iesrgs external " + scene + " --downscale 4 --scale 4 -o " + out + "/external"))
+      << fuse.output;
   EXPECT_FALSE(std::filesystem::exists(out));  // refused: no empty run folder left behind
 
   const CliRun rows = iesrgs("run " + scene + " -o " + out + " --rows best" + kTinySchedule);
@@ -196,6 +200,10 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_EQ(unused.status, 1);
   EXPECT_TRUE(contains(last_line(unused.output), "takes its D-SSIM weight from --dssim"))
       << unused.output;
+
+  const CliRun seed = iesrgs("run " + scene + " -o " + out + " --seed -5");
+  EXPECT_NE(seed.status, 0);
+  EXPECT_TRUE(contains(seed.output, "--seed: must be at least 0, got -5")) << seed.output;
 
   const CliRun threshold = iesrgs("run " + scene + " -o " + out + " --threshold -0.5");
   EXPECT_NE(threshold.status, 0);
@@ -246,9 +254,13 @@ TEST_F(RunCli, RowsReusedFromTheCacheAreLeftOutOfTheEta) {
 }
 
 // Labels say what trained a row when the options changed it: the ie-srgs row off the mask, the
-// E_depth row without a depth model (so trained as external only).
+// E_depth row without a depth model (so trained as external only). A run with no mask checks
+// none, and the earlier run's check is not left to pass for its own.
 TEST_F(RunCli, RowLabelsSayWhatTrainedThem) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
+  ASSERT_EQ(run_rows("ie-srgs").status, 0);
+  const std::filesystem::path agreement = dir / "run" / "diagnostics/mask_agreement.json";
+  ASSERT_TRUE(std::filesystem::exists(agreement));
   const CliRun run = run_rows("ie-srgs,external-depth", " --texture external");
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_TRUE(contains(run.output, "== row 2/2 ie-srgs: IE-SRGS, external texture (no mask) =="))
@@ -256,6 +268,7 @@ TEST_F(RunCli, RowLabelsSayWhatTrainedThem) {
   const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
   EXPECT_EQ(results["rows"][0]["label"], "+ E_depth (off: no --depth-model)");
   EXPECT_EQ(results["rows"][1]["label"], "IE-SRGS, external texture (no mask)");
+  EXPECT_FALSE(std::filesystem::exists(agreement));
 }
 
 TEST_F(RunCli, LowResolutionInputIsRenderedAtHrWithoutMetrics) {
