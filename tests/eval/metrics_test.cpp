@@ -7,6 +7,7 @@
 #include <string>
 
 #include "io/atomic_file.hpp"
+#include "loss/loss_test_support.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -34,6 +35,27 @@ TEST(Metrics, SsimIsOneOnlyForIdenticalImages) {
   for (size_t i = 0; i < noisy.data.size(); ++i) noisy.data[i] = float(i % 7) / 7;
   EXPECT_NEAR(ssim(noisy, noisy), 1.0, 1e-6);
   EXPECT_LT(ssim(noisy, filled(16, 16, 0.5f)), 0.5);
+}
+
+// The metric reads interleaved images: on a non-square image whose channels differ, it is the
+// channel mean of 3DGS's SSIM (the loss tests' float64 reference) of the planes.
+TEST(Metrics, SsimIsTheChannelMeanOfThePlanes) {
+  const int width = 21, height = 13;
+  const std::vector<double> x = loss_testing::random_values(size_t(width) * height * 3, 5),
+                            y = loss_testing::random_values(x.size(), 6);
+  Image a(width, height, 3), b(width, height, 3);
+  std::vector<double> x_planes(x.size()), y_planes(x.size());
+  for (int c = 0; c < 3; ++c)
+    for (int row = 0; row < height; ++row)
+      for (int col = 0; col < width; ++col) {
+        // Each channel's own blend of the two, so that mixing channels up changes the score.
+        const size_t i = (size_t(c) * height + row) * width + col;
+        x_planes[i] = a.at(col, row, c) = float(x[i]);
+        y_planes[i] = b.at(col, row, c) = float((c * x[i] + (2 - c) * y[i]) / 2);
+      }
+  const double expected =
+      loss_testing::mean(loss_testing::reference_ssim_map(x_planes, y_planes, {width, height, 3}));
+  EXPECT_NEAR(ssim(a, b), expected, 1e-5);
 }
 
 TEST(Metrics, ImagesOfOtherSizesOrChannelsAreRefused) {

@@ -24,14 +24,18 @@ TEST(Filter3d, NearestSeeingCameraAndLargestFocal) {
       1.2f, 0.f, 2.f,   // u = 100 * 0.6 + 50 = 110 for the first: inside the 15% margin
       3.0f, 0.f, 2.f,   // outside both frames
       0.f,  0.f, -1.f,  // behind the first camera, z = 2 for the second
+      0.f,  0.f, 5.f,   // nearest z is 5: the largest distance seen
+      0.f,  0.f, 0.1f,  // inside the first camera's near plane (z <= 0.2): z = 3.1 for the second
   };
-  const std::vector<float> s = filter3d_std(means, 4, cameras);
+  const std::vector<float> s = filter3d_std(means, 6, cameras);
   const double k = std::sqrt(0.2) / 150;  // largest focal
-  ASSERT_EQ(s.size(), 4u);
+  ASSERT_EQ(s.size(), 6u);
   EXPECT_NEAR(s[0], 2 * k, 1e-7);
   EXPECT_NEAR(s[1], 2 * k, 1e-7);
-  EXPECT_NEAR(s[2], 2 * k, 1e-7);  // unseen: the largest distance seen
+  EXPECT_NEAR(s[2], 5 * k, 1e-7);  // unseen: the largest distance seen
   EXPECT_NEAR(s[3], 2 * k, 1e-7);
+  EXPECT_NEAR(s[4], 5 * k, 1e-7);
+  EXPECT_NEAR(s[5], 3.1 * k, 1e-7);
 }
 
 TEST(Filter3d, FrameMarginIsFifteenPercent) {

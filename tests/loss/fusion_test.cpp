@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "loss/autograd.hpp"
+#include "loss/texture_fusion.hpp"
 #include "support/expect_error.hpp"
 
 namespace iesrgs::loss {
@@ -88,6 +89,53 @@ TEST(FusionLoss, DepthTermsVanishForMatchingGeometryAndIgnoreUncoveredPixels) {
   EXPECT_NEAR(terms.external_depth.item<double>(), 0, 1e-5);
 }
 
+// The rendered depth is alpha-blended z: the disparity correlated is alpha / blended z, the
+// inverse of the expected depth, and pixels under alpha 0.5 are left out.
+TEST(FusionLoss, ExternalDepthTermCorrelatesTheInverseExpectedDepthOfCoveredPixels) {
+  torch::manual_seed(11);
+  const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
+  torch::Tensor alpha = 0.6 + 0.4 * torch::rand({kHeight, kWidth});
+  alpha.narrow(1, 0, 2).fill_(0.49);
+  raster::RenderOutput render;
+  render.image = random_image(7);
+  render.alpha = alpha;
+  render.depth = depth * alpha;
+  FusionTargets targets = external_targets(5);
+  targets.external_disparity = 3 / depth + 0.5;
+  targets.external_disparity.narrow(1, 0, 2).fill_(-7);
+  const FusionLossTerms terms =
+      fusion_loss(render, targets, {TextureGuidance::External, 0.2, 0, 1e-4});
+  EXPECT_NEAR(terms.external_depth.item<double>(), 0, 1e-5);
+}
+
+// The paper's weights: l = 0.2 in L_tex, li = 0.001 on L_gem^I, le = 0.0001 on L_gem^E.
+TEST(FusionLoss, DefaultWeightsAreThePapersAndWeighTheTerms) {
+  const FusionWeights defaults;
+  EXPECT_EQ(defaults.texture, TextureGuidance::Masked);
+  EXPECT_EQ(defaults.dssim_weight, 0.2);
+  EXPECT_EQ(defaults.internal_depth, 1e-3);
+  EXPECT_EQ(defaults.external_depth, 1e-4);
+  EXPECT_EQ(kDiscrepancyThresholdSynthetic, 0.6);
+  EXPECT_EQ(kDiscrepancyThresholdReal, 0.9);
+
+  const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
+  raster::RenderOutput render = render_with_depth(depth, 2);
+  FusionTargets targets = external_targets(6);
+  targets.internal_image = random_image(9);
+  targets.internal_share =
+      internal_share(TextureGuidance::Masked, targets.internal_image, targets.external_image, 0.3);
+  targets.internal_depth = depth + 0.5;
+  torch::manual_seed(3);
+  targets.external_disparity = torch::rand({kHeight, kWidth});
+  const FusionLossTerms terms = fusion_loss(render, targets, defaults);
+  const double texture = terms.texture.item<double>();
+  EXPECT_GT(texture, 0);
+  EXPECT_NEAR(terms.total.item<double>(),
+              texture + 1e-3 * terms.internal_depth.item<double>() +
+                  1e-4 * terms.external_depth.item<double>(),
+              1e-7);  // float sums; swapping li and le would move it by about 4e-4
+}
+
 TEST(FusionLoss, DepthTermsPullTheRenderedDepthTowardsTheReferences) {
   const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
   raster::RenderOutput render = render_with_depth(depth, 0);
@@ -99,9 +147,11 @@ TEST(FusionLoss, DepthTermsPullTheRenderedDepthTowardsTheReferences) {
   EXPECT_NEAR(terms.internal_depth.item<double>(), 0.5, 1e-5);
   EXPECT_GT(terms.external_depth.item<double>(), 0.1);
   terms.total.backward();
-  // The internal term alone would push every rendered depth up (negative gradient).
-  EXPECT_TRUE(render.depth.grad().defined());
   EXPECT_GT(render.depth.grad().abs().sum().item<double>(), 0);
+  // The internal term alone pushes every rendered depth up (negative gradient).
+  render.depth.mutable_grad() = torch::Tensor();
+  fusion_loss(render, targets, {TextureGuidance::External, 0.2, 1e-3, 0}).total.backward();
+  EXPECT_TRUE(torch::all(render.depth.grad() < 0).item<bool>());
 }
 
 TEST(FusionLoss, InternalDepthTermIsZeroWhereNothingIsCovered) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "loss/loss_test_support.hpp"
@@ -25,6 +26,16 @@ TEST(DiscrepancyMask, ThresholdsTheChannelMeanOfTheRelativeDifference) {
             (std::vector<uint8_t>{1, 0, 1}));
   EXPECT_EQ(discrepancy_mask(internal.data(), external.data(), shape, kDiscrepancyThresholdReal),
             (std::vector<uint8_t>{0, 0, 0}));
+}
+
+// M(p) = [D(p) >= T]: a pixel whose discrepancy is the threshold itself takes the internal image.
+TEST(DiscrepancyMask, APixelAtTheThresholdIsMasked) {
+  const ImageShape shape{3, 1, 1};
+  const std::vector<double> internal{0.5, 0.7, 0.3}, external{0.9, 0.6, 0.2};
+  const double d = discrepancy_map(internal.data(), external.data(), shape)[0];
+  EXPECT_EQ(discrepancy_mask(internal.data(), external.data(), shape, d)[0], 1);
+  EXPECT_EQ(discrepancy_mask(internal.data(), external.data(), shape, std::nextafter(d, 1.0))[0],
+            0);
 }
 
 TEST(DiscrepancyMask, BlackInternalPixelsAlwaysDisagree) {

@@ -40,8 +40,13 @@ TEST(FusionStage, LoadsWhatTheLossUsesAndTheMaskFromTheDiscrepancy) {
   EXPECT_EQ(all.external_image.sizes(), (std::vector<int64_t>{3, 6, 8}));
   EXPECT_FLOAT_EQ(all.internal_depth[0][0].item<float>(), 2.0f);
   EXPECT_FLOAT_EQ(all.external_disparity[5][7].item<float>(), 0.5f);
+  EXPECT_TRUE((all.external_image == 0).all().item<bool>());
+  EXPECT_TRUE((all.internal_image == 1).all().item<bool>());
+  // D = |1 - 0| / (1 + 1e-6), just under 1: at or over T = 0.6, under T = 1.
   EXPECT_EQ(all.internal_share.sizes(), (std::vector<int64_t>{6, 8}));
-  EXPECT_TRUE(((all.internal_share == 0) | (all.internal_share == 1)).all().item<bool>());
+  EXPECT_TRUE((all.internal_share == 1).all().item<bool>());
+  const loss::FusionTargets strict = load_fusion_targets(refs.files, refs.camera, weights, 1.0);
+  EXPECT_TRUE((strict.internal_share == 0).all().item<bool>());
 
   weights.texture = loss::TextureGuidance::Average;
   const loss::FusionTargets average = load_fusion_targets(refs.files, refs.camera, weights, 0.6);

@@ -91,9 +91,8 @@ void expect_isotropic_closed_form(bool antialiased) {
   for (int y = 0; y < k.height; ++y)
     for (int x = 0; x < k.width; ++x) {
       const double d2 = std::pow(x + 0.5 - k.cx, 2) + std::pow(y + 0.5 - k.cy, 2);
-      double alpha =
-          std::min(double(kMaxAlpha), filtered_opacity * std::exp(-0.5 * d2 / (var + h)));
-      if (alpha < kMinAlpha) alpha = 0;
+      double alpha = std::min(kAlphaCap, filtered_opacity * std::exp(-0.5 * d2 / (var + h)));
+      if (alpha < kAlphaSkip) alpha = 0;
       const size_t i = size_t(y) * k.width + x;
       ASSERT_NEAR(r.alpha[i], alpha, 1e-12);
       ASSERT_NEAR(r.depth[i], alpha * z, 1e-12);

@@ -1,8 +1,7 @@
 #pragma once
 // Slow, straightforward double-precision renderer that the kernels are checked against: every
 // pixel against every projected Gaussian, sorted once by depth, written independently of the
-// kernels' math (host Vec3 / Mat3, SH as 3DGS's polynomial). Only the blending thresholds are
-// shared, as the float constants that define the cut-offs.
+// kernels' math (host Vec3 / Mat3, SH as 3DGS's polynomial).
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -10,10 +9,14 @@
 
 #include "core/math.hpp"
 #include "io/camera.hpp"
-#include "raster/project.hpp"
 #include "raster_test_scene.hpp"
 
 namespace iesrgs::raster::testkit {
+
+// 3DGS's cut-offs, written out rather than taken from the kernels' header, as the float values
+// the kernels compare with: alpha capped at 0.99, splats under 1/255 skipped, a pixel stopped
+// before its transmittance would drop under 1e-4.
+constexpr double kAlphaCap = 0.99f, kAlphaSkip = 1.0f / 255.0f, kTransmittanceStop = 1e-4f;
 
 struct ReferenceImage {
   int width = 0, height = 0;
@@ -120,9 +123,9 @@ inline ReferenceImage reference_render(const Scene<double>& s, const Camera& cam
         const double power =
             -0.5 * (r.conic[0] * dx * dx + r.conic[2] * dy * dy) - r.conic[1] * dx * dy;
         if (power > 0) continue;
-        const double alpha = std::min(double(kMaxAlpha), r.opacity * std::exp(power));
-        if (alpha < kMinAlpha) continue;
-        if (t * (1 - alpha) < kMinTransmittance) break;
+        const double alpha = std::min(kAlphaCap, r.opacity * std::exp(power));
+        if (alpha < kAlphaSkip) continue;
+        if (t * (1 - alpha) < kTransmittanceStop) break;
         for (int c = 0; c < 3; ++c) rgb[c] += r.color[c] * alpha * t;
         depth += r.depth * alpha * t;
         t *= 1 - alpha;
