@@ -262,6 +262,9 @@ void Trainer::require_same_cameras() const {
               "scene and --downscale");
 }
 
+// K distinct views drawn afresh each step, as METHOD.md states multi-view regulation. 3DGS and
+// MVGS pop views from a shuffled stack refilled each epoch, which also evens out how often each
+// view is seen.
 std::vector<int> Trainer::pick_views() {
   std::vector<int> order(setup_.train_views.size());
   std::iota(order.begin(), order.end(), 0);
@@ -306,7 +309,7 @@ double Trainer::step(int64_t iteration) {
   return total;
 }
 
-void Trainer::densify(int64_t iteration) {
+void Trainer::refine(int64_t iteration) {
   const TrainConfig& c = config_;
   if (iteration < c.densify_until) {
     if (iteration > c.densify_from && iteration % c.densify_every == 0) {
@@ -326,8 +329,9 @@ void Trainer::densify(int64_t iteration) {
     const bool white = setup_.background == std::array<float, 3>{1, 1, 1};
     if (iteration % c.opacity_reset_every == 0 || (white && iteration == c.densify_from))
       gs::reset_opacity(model_, *optimizer_);
-  } else if (iteration % c.filter_update_every == 0 && iteration < c.iterations - 100) {
-    // As Mip-Splatting: keep the filter current, but not in the last steps.
+  } else if (iteration > c.densify_until && iteration % c.filter_update_every == 0 &&
+             iteration < c.iterations - 100) {
+    // As Mip-Splatting: keep the filter current after densification, but not in the last steps.
     gs::update_filter_3d(model_, train_cameras_);
   }
 }
@@ -403,7 +407,7 @@ TrainSummary Trainer::run() {
       last_test_psnr_ = test_psnr;
     }
     // After the report: an opacity reset on the same iteration would make it read ~12 dB.
-    densify(iteration_);
+    refine(iteration_);
     const bool interrupted = interrupt_requested.load();
     log.record(iteration_, last_loss_, model_.size(), test_psnr, last || interrupted);
     if (last || interrupted ||

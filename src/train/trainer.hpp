@@ -104,7 +104,9 @@ class Trainer {
   torch::Tensor background_tensor() const;
   double step(int64_t iteration);  // one optimizer step; returns the loss
   std::vector<int> pick_views();
-  void densify(int64_t iteration);
+  // After a step, on 3DGS's and Mip-Splatting's schedules: densification and pruning, opacity
+  // resets, and the 3D filter's updates.
+  void refine(int64_t iteration);
   int64_t densify_cap() const;  // config.max_gaussians, or fewer when memory runs short
   void warn_memory_cap(int64_t iteration, int64_t cap, int64_t held_back);
   void save_checkpoint();
