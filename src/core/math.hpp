@@ -1,5 +1,6 @@
 #pragma once
-// Small fixed-size vector and matrix types for camera geometry (double precision on the host).
+// Small fixed-size vector and matrix types for camera geometry (double precision on the host),
+// and the scalar helpers around them (sigmoid and logit, median, evenly spaced picks, ...).
 #include <array>
 #include <cmath>
 #include <limits>

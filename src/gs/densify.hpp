@@ -60,8 +60,9 @@ struct DensifyCounts {
 
 // Clones small Gaussians and splits large ones whose mean gradient reaches the threshold, then
 // prunes transparent and (when enabled) oversized ones, then zeroes the stats. Split samples
-// come from torch's default generator. The reference zeroes the screen radii before its size
-// check, which disables it; here it uses the radii gathered since the last densification.
+// come from torch's default CPU generator, whatever the model's device. The reference zeroes the
+// screen radii before its size check, which disables it; here it uses the radii gathered since the
+// last densification.
 DensifyCounts densify_and_prune(GaussianModel& model, GaussianOptimizer& optimizer,
                                 DensifyStats& stats, const DensifyOptions& options,
                                 double scene_extent);

@@ -1,8 +1,8 @@
 #pragma once
-// SSIM, Pearson correlation and the fusion texture loss as torch autograd functions backed by the
-// hand-written kernels, so that they compose with tensor losses. CPU tensors, float32 or float64,
-// and in a CUDA build float32 tensors on a GPU; the second argument is a constant target (passing
-// one that requires grad is an error).
+// SSIM, Pearson correlation, the covered-depth L1, the photometric loss and the fusion texture
+// loss as torch autograd functions backed by the hand-written kernels, so that they compose with
+// tensor losses. CPU tensors, float32 or float64, and in a CUDA build float32 tensors on a GPU; the
+// second argument is a constant target (passing one that requires grad is an error).
 #include <ATen/core/Tensor.h>
 
 #include "loss/image_shape.hpp"

@@ -75,7 +75,7 @@ struct GaussianGrads {
   T* sh_rest = nullptr;
   // (N, 2) gradient of the projected mean in NDC units ([-1, 1] across the image), as 3DGS
   // reports it, so its 2e-4 densification threshold applies; and the sum over pixels of the
-  // absolute per-pixel contributions (Mip-Splatting / GOF), same units.
+  // absolute per-pixel contributions (AbsGS's statistic, gsplat's absgrad), same units.
   T* viewspace = nullptr;
   T* viewspace_abs = nullptr;
 };

@@ -52,7 +52,8 @@ struct TrainConfig {
 };
 
 // A built-in preset: "paper" (the 30k-iteration schedule of 3DGS and Mip-Splatting, for GPUs), or
-// "cpu" and "fast", which keep the algorithm and shorten the schedule to 10k and 3k iterations. The
+// "cpu" and "fast", which shorten the schedule to 10k and 3k iterations and leave the pruning of
+// world-large Gaussians off ("fast" also reports and checkpoints every 500 iterations). The
 // preset, with its schedule (densification window, opacity reset, SH steps, position decay)
 // rescaled to `iterations` when that is positive. Throws Error for an unknown name.
 TrainConfig make_preset(const std::string& name, int64_t iterations = 0);

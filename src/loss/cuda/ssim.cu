@@ -1,6 +1,6 @@
 // SSIM forward and backward on the GPU as separable passes over global memory: a row pass writes
 // each pixel's window statistics along its row, a column pass combines them along the column.
-// Per pixel, the arithmetic is the CPU kernels' (loss/ssim.cpp) in the same order.
+// Per pixel, the arithmetic is the CPU kernels' (loss/ssim_rows.cpp) in the same order.
 #include "loss/cuda/ssim.hpp"
 #include "loss/ssim_point.hpp"
 
@@ -35,7 +35,8 @@ struct Moments {
 };
 
 // Weighted statistics of window samples that are themselves means of sub-windows with their own
-// spread and covariance (zero for single pixels): loss/ssim.cpp's combine_moments at one pixel.
+// spread and covariance (zero for single pixels): loss/ssim_rows.cpp's combine_moments at one
+// pixel.
 template <typename Sample>
 __device__ Moments combine(const Taps& w, Sample&& sample) {
   Moments m{0.f, 0.f, 0.f, 0.f};

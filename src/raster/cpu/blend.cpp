@@ -317,7 +317,8 @@ void backward_blocks(const Splat<T>& s, uint32_t entry, BlockRun run, BackwardPi
     const Pack<T> da = t_front * (value - behind) + inv_opaque * load(px.dfinal + i);
     store(px.behind + i, a * value + (T(1) - a) * behind);
     store(px.transmittance + i, t_front);
-    // Alpha capped at 0.99 passes no gradient to opacity or shape.
+    // Alpha capped at 0.99 passes no gradient to opacity or shape: the derivative of the cap, as
+    // gsplat takes it (3DGS's kernel passes the uncapped alpha's).
     const Pack<T> da_live = select<T>((a > T(0)) & (weight <= T(kMaxAlpha)), da, Pack<T>{});
     acc.opacity += da_live * falloff;
     const Pack<T> dpower = a * da_live;

@@ -1,5 +1,6 @@
 #pragma once
-// The instruction-set variants (core/cpu_isa.hpp) of the CPU projection and blend passes.
+// How an instruction-set variant (core/cpu_isa.hpp) of the CPU kernels is described in reports;
+// dispatch.cpp runs the active one.
 #include <string>
 
 #include "core/cpu_isa.hpp"

@@ -9,7 +9,8 @@ template <typename T>
 void project_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam, Splat<T>* splats,
                      PixelRect* rects, int32_t* radii);
 // Overwrites grads with the parameter gradients of every Gaussian from the per-splat gradients.
-// Both projection passes run the active instruction-set variant (dispatch.hpp).
+// In float, both projection passes run the active instruction-set variant (cpu_isa::active(),
+// dispatched in dispatch.cpp); in double, the plain scalar code.
 template <typename T>
 void project_backward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
                       const SplatGrad<T>* splat_grads, const GaussianGrads<T>& grads);
@@ -21,7 +22,7 @@ void bin_splats(const Splat<T>* splats, const PixelRect* rects, int count, int w
 
 // Front-to-back blending of every tile; fills the frame's per-pixel state for the backward pass.
 // image (3, H, W), alpha and depth (H, W); depth is the alpha-blended camera z. Both blend passes
-// run the active instruction-set variant (dispatch.hpp).
+// run the active instruction-set variant (dispatched in dispatch.cpp).
 template <typename T>
 void blend_forward(RasterFrame<T>& frame, T* image, T* alpha, T* depth);
 // Back-to-front pass over every tile: per-entry partial gradients, reduced into

@@ -21,7 +21,7 @@ struct ProjectPacks {
   int lanes;  // Gaussians per pack
 };
 
-// The packs of the variant that dispatch.hpp makes active.
+// The packs of the variant cpu_isa::active() names (dispatch.cpp).
 ProjectPacks active_project_packs();
 
 template <typename T>
