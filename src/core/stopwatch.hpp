@@ -14,6 +14,12 @@ class Stopwatch {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
   double milliseconds() const { return 1e3 * seconds(); }
+  // Milliseconds since the start or the previous lap, which starts the next.
+  double lap_milliseconds() {
+    const double ms = milliseconds();
+    restart();
+    return ms;
+  }
 
  private:
   std::chrono::steady_clock::time_point start_;

@@ -10,8 +10,8 @@ namespace {
 
 using torch::Tensor;
 
-constexpr double kSplitScaleDivisor = 0.8 * 2;  // 3DGS: scale / (0.8 * N) with N = 2 samples
 constexpr int kSplitSamples = 2;
+constexpr double kSplitScaleDivisor = 0.8 * kSplitSamples;  // 3DGS: scale / (0.8 * N)
 
 void check_rows(const Tensor& t, int64_t n, const char* name) {
   if (!t.defined() || t.dim() == 0 || t.size(0) != n)

@@ -59,7 +59,7 @@ GaussianModel model_from_point_cloud(const PointCloud& cloud);
 // 3DGS's NeRF-Synthetic start: `count` points uniform in the cube of half-size `half_extent`
 // around `center` (3DGS: 1.3 around the origin) whose SH DC is uniform in [0, 1/255), i.e.
 // near-gray colors, exactly as its random init produces.
-GaussianModel model_from_random_box(int count = 100000, float half_extent = 1.3f, uint64_t seed = 0,
+GaussianModel model_from_random_box(int count, float half_extent, uint64_t seed,
                                     const Vec3& center = {});
 
 // Recomputes the Mip-Splatting 3D filter from the training cameras.

@@ -66,7 +66,7 @@ PointGrid build_grid(const float* points, int count) {
 // The k smallest squared distances seen so far, ascending.
 struct NearestK {
   int k;
-  std::array<float, 8> d2;
+  std::array<float, kScaleNeighbours> d2;
   int found = 0;
 
   void offer(float d) {
@@ -102,13 +102,12 @@ void scan_ring(const PointGrid& grid, const float* points, int self, const std::
 
 }  // namespace
 
-std::vector<float> mean_knn_squared_distance(const float* points, int count, int k) {
-  k = std::clamp(k, 1, 8);
+std::vector<float> mean_knn_squared_distance(const float* points, int count) {
   std::vector<float> result(count, 0.f);
   if (count < 2) return result;
   const PointGrid grid = build_grid(points, count);
   const int max_ring = std::max({grid.dims[0], grid.dims[1], grid.dims[2]});
-  const int wanted = std::min(k, count - 1);
+  const int wanted = std::min(kScaleNeighbours, count - 1);
 #pragma omp parallel for schedule(dynamic, 256)
   for (int i = 0; i < count; ++i) {
     const auto home = grid.cell_of(points + 3 * i);

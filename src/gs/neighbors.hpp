@@ -5,8 +5,12 @@
 
 namespace iesrgs::gs {
 
-// For each of the `count` points (row-major (N, 3)): the mean squared distance to its `k`
-// nearest other points (fewer when the cloud has fewer; 0 for a lone point). Exact.
-std::vector<float> mean_knn_squared_distance(const float* points, int count, int k = 3);
+// Neighbours per point, as 3DGS's simple-knn takes them.
+constexpr int kScaleNeighbours = 3;
+
+// For each of the `count` points (row-major (N, 3)): the mean squared distance to its
+// kScaleNeighbours nearest other points (fewer when the cloud has fewer; 0 for a lone point).
+// Exact.
+std::vector<float> mean_knn_squared_distance(const float* points, int count);
 
 }  // namespace iesrgs::gs

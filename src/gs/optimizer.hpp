@@ -8,7 +8,6 @@
 #include <array>
 #include <cstdint>
 
-#include "gs/adam.hpp"
 #include "gs/model.hpp"
 
 namespace iesrgs::gs {

@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "loss/autograd.hpp"
+#include "loss/depth_l1.hpp"
 #include "loss/texture_fusion.hpp"
 
 namespace iesrgs::loss {

@@ -7,7 +7,6 @@
 
 #include <string>
 
-#include "loss/depth_l1.hpp"
 #include "loss/photometric.hpp"
 #include "raster/autograd.hpp"
 

@@ -101,9 +101,10 @@ void check_inputs(const GaussianTensors& g, const ViewspaceProbes& probes) {
     check_tensor(probes.abs_grad, "viewspace abs probe", {n, 2}, device);
 }
 
-GaussianParams<float> params_of(const Tensor& means, const Tensor& log_scales, const Tensor& quats,
-                                const Tensor& logits, const Tensor& sh_dc, const Tensor& sh_rest,
-                                const Tensor& filter_std, int sh_degree, bool antialiased) {
+GaussianParams<float> params_of_tensors(const Tensor& means, const Tensor& log_scales,
+                                        const Tensor& quats, const Tensor& logits,
+                                        const Tensor& sh_dc, const Tensor& sh_rest,
+                                        const Tensor& filter_std, int sh_degree, bool antialiased) {
   GaussianParams<float> g;
   g.count = int(means.size(0));
   g.sh_degree = sh_degree;
@@ -138,8 +139,8 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     sh_dc = sh_dc.contiguous();
     sh_rest = sh_rest.contiguous();
     filter_std = present[0] ? filter_std.contiguous() : Tensor();
-    const GaussianParams<float> g = params_of(means, log_scales, quats, logits, sh_dc, sh_rest,
-                                              filter_std, int(sh_degree), antialiased);
+    const GaussianParams<float> g = params_of_tensors(
+        means, log_scales, quats, logits, sh_dc, sh_rest, filter_std, int(sh_degree), antialiased);
     auto holder = c10::make_intrusive<FrameHolder>();
     const auto f32 = means.options();
     Tensor image = torch::empty({3, camera.height, camera.width}, f32);
@@ -171,7 +172,7 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
   static variable_list backward(AutogradContext* ctx, variable_list grad_outputs) {
     const variable_list saved = ctx->get_saved_variables();
     const Tensor& means = saved[0];
-    const GaussianParams<float> g = params_of(
+    const GaussianParams<float> g = params_of_tensors(
         means, saved[1], saved[2], saved[3], saved[4], saved[5], saved[6],
         int(ctx->saved_data["sh_degree"].toInt()), ctx->saved_data["antialiased"].toBool());
     auto holder =
@@ -234,9 +235,9 @@ GaussianParams<float> kernel_params(const GaussianTensors& gaussians) {
        {&gaussians.means, &gaussians.log_scales, &gaussians.quats, &gaussians.opacity_logits,
         &gaussians.sh_dc, &gaussians.sh_rest, &gaussians.filter_std})
     if (t->defined() && !t->is_contiguous()) fail("kernel_params: a tensor is not contiguous");
-  return params_of(gaussians.means, gaussians.log_scales, gaussians.quats, gaussians.opacity_logits,
-                   gaussians.sh_dc, gaussians.sh_rest, gaussians.filter_std, gaussians.sh_degree,
-                   gaussians.antialiased);
+  return params_of_tensors(gaussians.means, gaussians.log_scales, gaussians.quats,
+                           gaussians.opacity_logits, gaussians.sh_dc, gaussians.sh_rest,
+                           gaussians.filter_std, gaussians.sh_degree, gaussians.antialiased);
 }
 
 }  // namespace iesrgs::raster

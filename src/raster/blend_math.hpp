@@ -2,9 +2,17 @@
 // Per-pixel evaluation of a splat, shared by the forward and backward blending kernels. The
 // functions are templated on the value type V as well, so that the CPU kernels can evaluate four
 // pixels at once with SIMD packs.
-#include "raster/project.hpp"
+#include "core/hd.hpp"
+#include "raster/types.hpp"
 
 namespace iesrgs::raster {
+
+// Blending thresholds as float constants, so that the double instantiation cuts exactly where
+// the float one does: e.g. two splats at the 0.99 cap leave a transmittance just below 1e-4 in
+// float (the pixel stops) but just above it with a double 0.99.
+constexpr float kMinAlpha = 1.0f / 255.0f;
+constexpr float kMaxAlpha = 0.99f;
+constexpr float kMinTransmittance = 1e-4f;
 
 // Exponent of the splat's Gaussian; (dx, dy) is the mean minus the pixel center.
 template <typename T, typename V>

@@ -7,6 +7,7 @@
 #include "core/geometry.hpp"
 #include "gs/mip_filter.hpp"
 #include "gs/sh.hpp"
+#include "raster/blend_math.hpp"
 #include "raster/types.hpp"
 
 namespace iesrgs::raster {
@@ -14,13 +15,6 @@ namespace iesrgs::raster {
 // The Jacobian is taken no further out than this fraction of the image's half-width (height)
 // beyond each edge: 3DGS's 1.3 x tan(fov / 2) for a centred principal point.
 constexpr double kJacobianMargin = 0.3;
-// Blending thresholds as float constants, so that the double instantiation cuts exactly where
-// the float one does: e.g. two splats at the 0.99 cap leave a transmittance just below 1e-4 in
-// float (the pixel stops) but just above it with a double 0.99.
-constexpr float kMinAlpha = 1.0f / 255.0f;
-constexpr float kMaxAlpha = 0.99f;
-constexpr float kMinTransmittance = 1e-4f;
-
 // Every intermediate of the projection that the backward pass needs.
 template <typename T>
 struct Projection {
@@ -202,7 +196,10 @@ template <typename T>
 struct SplatBounds {
   T x0, y0, x1, y1;  // pixels [x0, x1) x [y0, y1), clamped to the image
   // Reported for densification: the larger half-extent of the box. Being the extent where alpha
-  // reaches 1/255, not 3DGS's 3 sigma, it is smaller for faint splats, which max_screen_size sees.
+  // reaches 1/255, not 3DGS's 3 sigma, it is smaller for faint splats, which max_screen_size sees;
+  // and a view where it is zero (a splat too faint to draw anywhere, as after an opacity reset)
+  // is not counted in the mean view-space gradient, where 3DGS counts every view its 3-sigma box
+  // reaches.
   T radius;
 };
 

@@ -1,31 +1,13 @@
 #include "raster/rasterizer.hpp"
 
 #include <algorithm>
-#include <chrono>
 
 #include "core/error.hpp"
+#include "core/stopwatch.hpp"
 #include "gs/sh.hpp"
 #include "raster/cpu/kernels.hpp"
 
 namespace iesrgs::raster {
-
-namespace {
-
-class StageTimer {
- public:
-  // Milliseconds since construction or the previous call.
-  double lap() {
-    const auto now = std::chrono::steady_clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-    return ms;
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
-
-}  // namespace
 
 template <typename T>
 RasterCamera<T> raster_camera(const Camera& camera) {
@@ -78,14 +60,14 @@ void rasterize_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
   std::copy_n(background, 3, frame.background);
   frame.splats.resize(g.count);
   frame.rects.resize(g.count);
-  StageTimer timer;
+  Stopwatch timer;
   cpu::project_forward(g, cam, frame.splats.data(), frame.rects.data(), out.radii);
-  frame.timings.project = timer.lap();
+  frame.timings.project = timer.lap_milliseconds();
   cpu::bin_splats(frame.splats.data(), frame.rects.data(), g.count, cam.width, cam.height,
                   frame.bins);
-  frame.timings.bin = timer.lap();
+  frame.timings.bin = timer.lap_milliseconds();
   cpu::blend_forward(frame, out.image, out.alpha, out.depth);
-  frame.timings.blend = timer.lap();
+  frame.timings.blend = timer.lap_milliseconds();
 }
 
 template <typename T>
@@ -95,11 +77,11 @@ void rasterize_backward(const GaussianParams<T>& g, RasterFrame<T>& frame,
     fail("rasterizer: backward got {} Gaussians, forward rendered {}", g.count,
          frame.splats.size());
   validate_grads(grads, g.count);
-  StageTimer timer;
+  Stopwatch timer;
   cpu::blend_backward(frame, pixel_grads.image, pixel_grads.alpha, pixel_grads.depth);
-  frame.timings.blend_backward = timer.lap();
+  frame.timings.blend_backward = timer.lap_milliseconds();
   cpu::project_backward(g, frame.camera, frame.splat_grads.data(), grads);
-  frame.timings.project_backward = timer.lap();
+  frame.timings.project_backward = timer.lap_milliseconds();
 }
 
 template RasterCamera<float> raster_camera(const Camera&);

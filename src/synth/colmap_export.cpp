@@ -5,6 +5,7 @@
 
 #include "core/math.hpp"
 #include "io/camera.hpp"
+#include "io/viewer_cloud.hpp"
 
 namespace iesrgs::synth {
 
@@ -12,15 +13,11 @@ namespace {
 
 constexpr uint32_t kCameraId = 1;
 
-uint8_t to_byte(float v) {
-  return uint8_t(std::lround(std::clamp(v, 0.f, 1.f) * 255.f));
-}
-
 }  // namespace
 
 ColmapExport::ColmapExport(const RenderSettings& settings, int points_per_view)
     : settings_(settings), points_per_view_(points_per_view) {
-  const double focal = 0.5 * settings.width / std::tan(0.5 * settings.camera_angle_x);
+  const double focal = settings.focal();
   model_.cameras[kCameraId] = {kCameraId,
                                "PINHOLE",
                                uint64_t(settings.width),
@@ -61,9 +58,9 @@ void ColmapExport::add_view(const CameraPose& pose, const RenderedView& view,
       ColmapPoint point;
       point.id = model_.points.size() + 1;
       point.x = world.x, point.y = world.y, point.z = world.z;
-      point.r = to_byte(view.rgba.at(x, y, 0));
-      point.g = to_byte(view.rgba.at(x, y, 1));
-      point.b = to_byte(view.rgba.at(x, y, 2));
+      point.r = to_byte(255.0 * view.rgba.at(x, y, 0));
+      point.g = to_byte(255.0 * view.rgba.at(x, y, 1));
+      point.b = to_byte(255.0 * view.rgba.at(x, y, 2));
       point.track.push_back({image.id, uint32_t(image.observations.size())});
       image.observations.push_back({u, v, int64_t(point.id)});
       model_.points.push_back(std::move(point));

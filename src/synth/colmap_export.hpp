@@ -2,10 +2,8 @@
 // The synthetic scene as a COLMAP capture: opaque photos in images/ and a sparse model in
 // sparse/0 whose points stand in for structure-from-motion points (surface samples with their
 // colours), so the COLMAP path, SfM initialization included, can run without COLMAP.
-#include <cstdint>
 #include <filesystem>
 #include <string>
-#include <vector>
 
 #include "io/colmap.hpp"
 #include "synth/camera_path.hpp"
@@ -22,8 +20,6 @@ class ColmapExport {
   void add_view(const CameraPose& pose, const RenderedView& view, const std::string& name);
   // Writes sparse/0/{cameras,images,points3D}.bin under `dir`.
   void write(const std::filesystem::path& dir) const;
-
-  const ColmapModel& model() const { return model_; }
 
  private:
   RenderSettings settings_;

@@ -119,8 +119,7 @@ RenderedView render_view(const SynthScene& scene, const CameraPose& pose,
   view.rgba = Image(settings.width, settings.height, 4);
   view.depth.assign(view.rgba.pixels(), 0.f);
   const Tracer tracer(scene);
-  const PixelSampler sampler{tracer, pose, settings,
-                             0.5 * settings.width / std::tan(0.5 * settings.camera_angle_x)};
+  const PixelSampler sampler{tracer, pose, settings, settings.focal()};
 #pragma omp parallel for schedule(dynamic)
   for (int y = 0; y < settings.height; ++y)
     for (int x = 0; x < settings.width; ++x) sampler.render(x, y, view);

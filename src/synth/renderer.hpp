@@ -1,6 +1,7 @@
 #pragma once
 // A small ray tracer for the synthetic scene: exact primary hits, Lambertian shading with hard
 // shadows from one directional light, antialiased by stratified supersampling.
+#include <cmath>
 #include <vector>
 
 #include "io/image.hpp"
@@ -13,6 +14,8 @@ struct RenderSettings {
   int width = 0, height = 0;
   double camera_angle_x = kCameraAngleX;  // horizontal field of view, radians
   int grid = 4;  // samples per pixel along each axis: grid x grid jittered samples
+
+  double focal() const { return 0.5 * width / std::tan(0.5 * camera_angle_x); }  // pixels
 };
 
 struct RenderedView {

@@ -40,8 +40,6 @@ ProgressLog::ProgressLog(const std::filesystem::path& csv, int64_t first_iterati
       total_iterations_(total_iterations),
       log_every_(log_every),
       seconds_before_(seconds_before),
-      start_(Clock::now()),
-      last_print_(start_),
       last_print_iteration_(first_iteration) {
   if (!csv.parent_path().empty()) std::filesystem::create_directories(csv.parent_path());
   write_file_atomically(csv, first_iteration > 0 ? log_until(csv, first_iteration) : kHeader);
@@ -58,28 +56,27 @@ void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
   smoothed_loss_ = iteration == first_iteration_ + 1
                        ? loss
                        : kLossSmoothing * smoothed_loss_ + (1 - kLossSmoothing) * loss;
-  const Clock::time_point now = Clock::now();
-  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  const double elapsed = run_.seconds();
   if (force || test_psnr || iteration % log_every_ == 0) {
     csv_ << iteration << ',' << loss << ',' << gaussians << ',' << seconds_before_ + elapsed << ',';
     if (test_psnr) csv_ << *test_psnr;
     csv_ << '\n';
   }
-  const double since_print = std::chrono::duration<double>(now - last_print_).count();
+  const double since_print = since_print_.seconds();
   if (!force && !test_psnr && since_print < kPrintSeconds) return;
   csv_.flush();
   const double rate = since_print > 0 ? double(iteration - last_print_iteration_) / since_print : 0;
-  const double overall = elapsed > 0 ? double(iteration - first_iteration_) / elapsed : 0;
-  const double eta = overall > 0 ? double(total_iterations_ - iteration) / overall : 0;
   std::string line = fmt::format(
       "[{:>{}}/{}] {:5.1f}% | {:6.2f} it/s | loss {:.4f} | {:>8} Gaussians | elapsed {} | ETA {}",
       iteration, std::to_string(total_iterations_).size(), total_iterations_,
       100.0 * double(iteration) / double(total_iterations_), rate, smoothed_loss_, gaussians,
-      format_duration(elapsed), format_duration(eta));
+      format_duration(elapsed),
+      format_eta(size_t(iteration - first_iteration_), size_t(total_iterations_ - first_iteration_),
+                 elapsed));
   if (test_psnr) line += fmt::format(" | test PSNR {:.2f} dB", *test_psnr);
   fmt::print("{}\n", line);
   std::fflush(stdout);
-  last_print_ = now;
+  since_print_.restart();
   last_print_iteration_ = iteration;
 }
 

@@ -1,12 +1,13 @@
 #pragma once
 // What a training run tells the person watching it (a line every couple of seconds: iteration,
 // it/s, loss, Gaussians, ETA, test PSNR when measured) and the CSV log kept beside the outputs.
-#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
+
+#include "core/stopwatch.hpp"
 
 namespace iesrgs::train {
 
@@ -27,11 +28,10 @@ class ProgressLog {
   void flush();
 
  private:
-  using Clock = std::chrono::steady_clock;
   std::ofstream csv_;
   int64_t first_iteration_, total_iterations_, log_every_;
   double seconds_before_;
-  Clock::time_point start_, last_print_;
+  Stopwatch run_, since_print_;
   int64_t last_print_iteration_;
   double smoothed_loss_ = 0;
 };

@@ -101,7 +101,8 @@ TEST(GaussianModel, CoincidentPointsGetTheMinimumScale) {
 }
 
 TEST(GaussianModel, RandomBoxMatchesNerfSyntheticDefault) {
-  const GaussianModel m = model_from_random_box();  // 100k points: the grid search must be fast
+  // 3DGS's 100k points: the grid search must be fast.
+  const GaussianModel m = model_from_random_box(100000, 1.3f, 0);
   ASSERT_EQ(m.size(), 100000);
   EXPECT_LE(m.means.abs().max().item<float>(), 1.3f);
   EXPECT_GT(m.means.abs().max().item<float>(), 1.29f);

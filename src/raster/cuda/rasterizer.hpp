@@ -4,7 +4,6 @@
 // Every array handed in or out is in device memory; float only. Plain C++ header: callers need
 // the CUDA runtime's headers, not its compiler.
 #include <memory>
-#include <string>
 
 #include "core/cuda/device_array.hpp"
 #include "raster/frame.hpp"
