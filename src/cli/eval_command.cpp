@@ -30,7 +30,7 @@ struct EvalArgs {
   std::string output;
   std::string split = "test";
   int downscale = 1;
-  std::string background = "white";
+  std::string background = "auto";
   std::string lpips = "alex";
 };
 
@@ -79,11 +79,13 @@ void check_render_record(const EvalArgs& args) {
 class GroundTruth {
  public:
   GroundTruth(const EvalArgs& args, const SceneOptions& options) : root_(args.ground_truth) {
-    background_ = options.background;
+    // A plain folder of RGBA images is taken for NeRF Synthetic's.
+    background_ = options.background.value_or(std::array<float, 3>{1, 1, 1});
     if (!is_scene(root_) && !std::filesystem::is_directory(root_))
       fail_file(root_, "ground truth not found: neither a scene nor a folder of images");
     if (is_scene(root_)) {
       scene_.emplace(load_scene(root_, options));
+      background_ = scene_->background;
       images_.emplace(*scene_);
       const Split split = args.split == "train" ? Split::Train : Split::Test;
       for (const Camera* camera : scene_->split(split)) {
@@ -202,7 +204,10 @@ void add_eval_command(CLI::App& app) {
       ->check(kPositive)
       ->capture_default_str();
   command
-      ->add_option("--background", args->background, "Background for RGBA renders and ground truth")
+      ->add_option("--background", args->background,
+                   "Background for RGBA renders and ground truth: as a scene's (auto: white for "
+                   "NeRF Synthetic and for a plain folder, black for captures), white, black or "
+                   "r,g,b")
       ->capture_default_str();
   add_lpips_option(*command, args->lpips);
   command->callback([args] { run_eval(*args); });

@@ -15,7 +15,8 @@ void SceneArgs::add_to(CLI::App& command, const std::string& what) {
       ->capture_default_str();
   command
       .add_option("--background", background,
-                  "Background for RGBA images: white, black, or r,g,b in [0,1]")
+                  "Background behind the model and under RGBA images: white, black, r,g,b in "
+                  "[0,1], or auto (white for NeRF Synthetic scenes, black for captures, as 3DGS)")
       ->capture_default_str();
   command
       .add_option("--test-every", options.test_every,
@@ -26,7 +27,9 @@ void SceneArgs::add_to(CLI::App& command, const std::string& what) {
 
 SceneOptions SceneArgs::resolved() const {
   SceneOptions resolved = options;
-  if (background == "white") {
+  if (background == "auto") {
+    resolved.background.reset();
+  } else if (background == "white") {
     resolved.background = {1, 1, 1};
   } else if (background == "black") {
     resolved.background = {0, 0, 0};
@@ -34,7 +37,7 @@ SceneOptions SceneArgs::resolved() const {
     float r, g, b;
     char tail;
     if (std::sscanf(background.c_str(), "%f,%f,%f%c", &r, &g, &b, &tail) != 3)
-      fail("--background: expected white, black or r,g,b, got '{}'", background);
+      fail("--background: expected auto, white, black or r,g,b, got '{}'", background);
     for (float channel : {r, g, b})
       if (!(channel >= 0 && channel <= 1))
         fail("--background: each of r,g,b must be in [0, 1], got '{}'", background);

@@ -11,7 +11,7 @@ namespace iesrgs::cli {
 struct SceneArgs {
   std::string path;
   SceneOptions options;
-  std::string background = "white";
+  std::string background = "auto";
 
   // Registers the positional scene path (described by `what`, the scene formats by default) and
   // the loading options on `command`.

@@ -167,7 +167,8 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   if (scene.cameras.empty()) fail_file(root, "scene has no cameras");
   scene.root = root;
   require_unique_names(scene);
-  scene.background = options.background;
+  scene.background = options.background.value_or(scene.synthetic ? std::array<float, 3>{1, 1, 1}
+                                                                 : std::array<float, 3>{0, 0, 0});
   scene.downscale = options.downscale;
   for (Camera& camera : scene.cameras) {
     require_pinhole_view(camera);

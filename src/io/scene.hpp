@@ -29,7 +29,7 @@ struct Scene {
   std::string format;  // "blender", "nerfstudio" or "colmap"
   std::vector<Camera> cameras;
   PointCloud points;
-  std::array<float, 3> background{1, 1, 1};  // RGBA images are composited over it
+  std::array<float, 3> background{1, 1, 1};  // rendered behind the model; RGBA images over it
   bool synthetic = false;  // object-centric with a known bounding volume (NeRF Synthetic)
   int downscale = 1;       // cameras' intrinsics are the stored ones divided by this
 
@@ -38,9 +38,11 @@ struct Scene {
 };
 
 struct SceneOptions {
-  int downscale = 1;                         // read <images>_<k> when present, else resize
-  std::array<float, 3> background{1, 1, 1};  // for RGBA images
-  int test_every = 8;                        // LLFF hold-out for formats without a test split
+  int downscale = 1;  // read <images>_<k> when present, else resize
+  // Unset: white for NeRF Synthetic scenes, black for captures (COLMAP, nerfstudio), as 3DGS
+  // trains them (its --white_background is for the synthetic scenes).
+  std::optional<std::array<float, 3>> background{};
+  int test_every = 8;  // LLFF hold-out for formats without a test split
 };
 
 // Detects the format from the files present and loads cameras and points (not the images).

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -29,6 +30,20 @@ TEST(Scene, NormalizationAsGaussianSplatting) {
   const SceneNormalization norm = scene.normalization();
   EXPECT_NEAR(norm.center.x, -1, 1e-12);
   EXPECT_NEAR(norm.radius, 1.1, 1e-12);
+}
+
+// As 3DGS trains them: NeRF Synthetic over white, captures over black, unless told otherwise.
+TEST(Scene, TheDefaultBackgroundIsWhiteForNerfSyntheticAndBlackForCaptures) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "blender", {synth::SynthFormat::Blender, 8, 2, 1});
+  synth::write_synth_dataset(dir / "colmap", {synth::SynthFormat::Colmap, 8, 3, 0});
+  const std::array<float, 3> white{1, 1, 1}, black{0, 0, 0}, blue{0, 0, 1};
+  EXPECT_EQ(load_scene(dir / "blender").background, white);
+  EXPECT_EQ(load_scene(dir / "colmap").background, black);
+  SceneOptions options;
+  options.background = blue;
+  EXPECT_EQ(load_scene(dir / "blender", options).background, blue);
+  EXPECT_EQ(load_scene(dir / "colmap", options).background, blue);
 }
 
 TEST(Scene, TwoViewsOfASplitWithOneNameAreRefused) {
