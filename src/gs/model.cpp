@@ -148,7 +148,7 @@ GaussianModel model_from_random_box(int count, float half_extent, uint64_t seed,
 }
 
 void update_filter_3d(GaussianModel& model, const std::vector<Camera>& cameras) {
-  // On the CPU wherever the model is: it runs at most every 100 iterations.
+  // On the CPU wherever the model is: it runs once per densification step or filter update.
   const std::vector<float> std_dev =
       filter3d_std(values_of(model.means).data(), int(model.size()), cameras);
   model.filter_3d = tensor_of(std_dev, {model.size()}).to(model.means.device());

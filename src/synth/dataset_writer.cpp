@@ -71,15 +71,15 @@ class DatasetWriter {
                           transforms.dump(4) + "\n");
   }
 
-  // Opaque photos over white, as a camera would take them; the model is written last, so a
-  // complete sparse/0 means complete images.
+  // Opaque photos over black, as a camera would take them and as captures are trained; the model
+  // is written last, so a complete sparse/0 means complete images.
   void write_colmap(const std::vector<CameraPose>& poses) {
     ColmapExport colmap(settings_, kPointsPerView);
-    const float white[3] = {1, 1, 1};
+    const float black[3] = {0, 0, 0};
     for (size_t i = 0; i < poses.size(); ++i) {
       const std::string stem = fmt::format("r_{:04d}", i);
       const RenderedView view = render(poses[i], dir_ / "depth" / (stem + ".npy"));
-      write_png(dir_ / "images" / (stem + ".png"), composite_rgb(to_8bit(view.rgba), white));
+      write_png(dir_ / "images" / (stem + ".png"), composite_rgb(to_8bit(view.rgba), black));
       colmap.add_view(poses[i], view, stem + ".png");
     }
     colmap.write(dir_);

@@ -4,7 +4,7 @@
 //   background, and ground-truth depth <split>/r_<i>_depth.npy (float32, height x width, 0 where
 //   nothing is hit);
 // - COLMAP: one capture of train + test views over the upper hemisphere as opaque photos
-//   images/r_<iiii>.png (white background) with depth in depth/r_<iiii>.npy, and sparse/0 holding
+//   images/r_<iiii>.png (black background) with depth in depth/r_<iiii>.npy, and sparse/0 holding
 //   the cameras, poses and surface points standing in for SfM points. The reader's every-8th-image
 //   hold-out makes its test split.
 #include <cstdint>

@@ -64,6 +64,7 @@ void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
   }
   const double since_print = since_print_.seconds();
   if (!force && !test_psnr && since_print < kPrintSeconds) return;
+  since_print_.restart();
   csv_.flush();
   const double rate = since_print > 0 ? double(iteration - last_print_iteration_) / since_print : 0;
   std::string line = fmt::format(
@@ -76,7 +77,6 @@ void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
   if (test_psnr) line += fmt::format(" | test PSNR {:.2f} dB", *test_psnr);
   fmt::print("{}\n", line);
   std::fflush(stdout);
-  since_print_.restart();
   last_print_iteration_ = iteration;
 }
 

@@ -262,8 +262,8 @@ void Trainer::require_same_cameras() const {
               "scene and --downscale");
 }
 
-// K distinct views drawn afresh each step, as METHOD.md states multi-view regulation. 3DGS and
-// MVGS pop views from a shuffled stack refilled each epoch, which also evens out how often each
+// K distinct views drawn afresh each step: multi-view regulation. The code of 3DGS and MVGS pops
+// views from a shuffled stack refilled each epoch instead, which also evens out how often each
 // view is seen.
 std::vector<int> Trainer::pick_views() {
   std::vector<int> order(setup_.train_views.size());

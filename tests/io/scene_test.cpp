@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.hpp"
+#include "io/image.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 #include "synth/dataset_writer.hpp"
@@ -39,7 +40,11 @@ TEST(Scene, TheDefaultBackgroundIsWhiteForNerfSyntheticAndBlackForCaptures) {
   synth::write_synth_dataset(dir / "colmap", {synth::SynthFormat::Colmap, 8, 3, 0});
   const std::array<float, 3> white{1, 1, 1}, black{0, 0, 0}, blue{0, 0, 1};
   EXPECT_EQ(load_scene(dir / "blender").background, white);
-  EXPECT_EQ(load_scene(dir / "colmap").background, black);
+  const Scene capture = load_scene(dir / "colmap");
+  EXPECT_EQ(capture.background, black);
+  // The synthetic capture's photos show that background where the object is not.
+  const Image8 photo = read_image8(capture.cameras.front().image_path);
+  EXPECT_EQ(photo.at(0, 0, 0) + photo.at(0, 0, 1) + photo.at(0, 0, 2), 0);
   SceneOptions options;
   options.background = blue;
   EXPECT_EQ(load_scene(dir / "blender", options).background, blue);

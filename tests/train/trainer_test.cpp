@@ -199,6 +199,7 @@ TEST_F(TrainerTest, InterruptedRunResumesToTheSameModel) {
   // Both runs' training time: the first run's (at least the 1 s it slept) and the second's own,
   // which its run() call holds.
   EXPECT_GT(resumed.seconds, partial.seconds);
+  EXPECT_GT(resumed.seconds, second_run.count());
   EXPECT_LT(resumed.seconds, partial.seconds + second_run.count());
   // A log row every log_every (10) iterations and at the interruption, in order, across both
   // runs.
