@@ -308,6 +308,29 @@ TEST(Cli, EvalCompositesRgbaRendersOverTheBackground) {
   const CliRun on_black = iesrgs("eval --lpips none --background black " + folders);
   EXPECT_EQ(on_black.status, 0) << on_black.output;
   EXPECT_TRUE(contains(on_black.output, "1 views: PSNR 0.000 dB")) << on_black.output;
+
+  // Against a capture, the scene's background (black): the held-out photo, with white
+  // transparent pixels where it shows the background, scores as the photo itself.
+  const std::string capture = (dir / "capture").string();
+  ASSERT_EQ(
+      iesrgs("synth -o " + capture + " --size 16 --views 7 --test-views 1 --format colmap").status,
+      0);
+  const Image8 photo = read_image8(dir / "capture" / "images" / "r_0000.png");
+  Image8 rgba(photo.width, photo.height, 4);
+  size_t transparent_pixels = 0;
+  for (int y = 0; y < photo.height; ++y)
+    for (int x = 0; x < photo.width; ++x) {
+      const bool background = photo.at(x, y, 0) + photo.at(x, y, 1) + photo.at(x, y, 2) == 0;
+      transparent_pixels += background;
+      for (int c = 0; c < 3; ++c) rgba.at(x, y, c) = background ? 255 : photo.at(x, y, c);
+      rgba.at(x, y, 3) = background ? 0 : 255;
+    }
+  ASSERT_GT(transparent_pixels, 0u);
+  write_png(dir / "capture_renders" / "r_0000.png", rgba);
+  const CliRun on_capture =
+      iesrgs("eval --lpips none " + (dir / "capture_renders").string() + " " + capture);
+  EXPECT_EQ(on_capture.status, 0) << on_capture.output;
+  EXPECT_TRUE(contains(on_capture.output, "1 views: PSNR inf dB")) << on_capture.output;
 }
 
 TEST(Cli, EvalOfPartOfASplitNamesTheViewsLeftOut) {
