@@ -79,8 +79,6 @@ void check_render_record(const EvalArgs& args) {
 class GroundTruth {
  public:
   GroundTruth(const EvalArgs& args, const SceneOptions& options) : root_(args.ground_truth) {
-    // A plain folder of RGBA images is taken for NeRF Synthetic's.
-    background_ = options.background.value_or(std::array<float, 3>{1, 1, 1});
     if (!is_scene(root_) && !std::filesystem::is_directory(root_))
       fail_file(root_, "ground truth not found: neither a scene nor a folder of images");
     if (is_scene(root_)) {
@@ -93,6 +91,8 @@ class GroundTruth {
         names_.push_back(camera->name);
       }
     } else {
+      // A plain folder of RGBA images is taken for NeRF Synthetic's.
+      background_ = options.background.value_or(std::array<float, 3>{1, 1, 1});
       for (const std::filesystem::path& image : image_files_in(root_))
         names_.push_back(image.stem().string());
     }

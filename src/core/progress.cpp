@@ -22,9 +22,7 @@ std::string format_eta(size_t done, size_t total, double seconds) {
 }
 
 std::string ItemPace::finished(size_t done) {
-  const double item = item_.seconds();
-  item_.restart();
-  return fmt::format("{:.2f} s, ETA {}", item, format_eta(done, total_, all_.seconds()));
+  return fmt::format("{:.2f} s, ETA {}", item_.lap(), format_eta(done, total_, all_.seconds()));
 }
 
 }  // namespace iesrgs

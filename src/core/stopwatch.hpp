@@ -14,11 +14,11 @@ class Stopwatch {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
   double milliseconds() const { return 1e3 * seconds(); }
-  // Milliseconds since the start or the previous lap, which starts the next.
-  double lap_milliseconds() {
-    const double ms = milliseconds();
+  // Seconds since the start or the previous lap, which starts the next.
+  double lap() {
+    const double s = seconds();
     restart();
-    return ms;
+    return s;
   }
 
  private:

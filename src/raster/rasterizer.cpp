@@ -62,12 +62,12 @@ void rasterize_forward(const GaussianParams<T>& g, const RasterCamera<T>& cam,
   frame.rects.resize(g.count);
   Stopwatch timer;
   cpu::project_forward(g, cam, frame.splats.data(), frame.rects.data(), out.radii);
-  frame.timings.project = timer.lap_milliseconds();
+  frame.timings.project = 1e3 * timer.lap();
   cpu::bin_splats(frame.splats.data(), frame.rects.data(), g.count, cam.width, cam.height,
                   frame.bins);
-  frame.timings.bin = timer.lap_milliseconds();
+  frame.timings.bin = 1e3 * timer.lap();
   cpu::blend_forward(frame, out.image, out.alpha, out.depth);
-  frame.timings.blend = timer.lap_milliseconds();
+  frame.timings.blend = 1e3 * timer.lap();
 }
 
 template <typename T>
@@ -79,9 +79,9 @@ void rasterize_backward(const GaussianParams<T>& g, RasterFrame<T>& frame,
   validate_grads(grads, g.count);
   Stopwatch timer;
   cpu::blend_backward(frame, pixel_grads.image, pixel_grads.alpha, pixel_grads.depth);
-  frame.timings.blend_backward = timer.lap_milliseconds();
+  frame.timings.blend_backward = 1e3 * timer.lap();
   cpu::project_backward(g, frame.camera, frame.splat_grads.data(), grads);
-  frame.timings.project_backward = timer.lap_milliseconds();
+  frame.timings.project_backward = 1e3 * timer.lap();
 }
 
 template RasterCamera<float> raster_camera(const Camera&);
