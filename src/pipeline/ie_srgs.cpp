@@ -37,6 +37,26 @@ namespace {
 namespace fs = std::filesystem;
 using loss::TextureGuidance;
 
+// The `iesrgs external` command that makes the external stage a run with these options reads:
+// the LR scene as the run loads it, and every option that changes the stage's images.
+std::string external_stage_command(const RunOptions& o, int lr_downscale) {
+  const ExternalOptions& external = o.external;
+  std::string command = fmt::format("iesrgs external {} --downscale {} --scale {} --sr-model {}",
+                                    o.scene.string(), lr_downscale, o.scale, external.sr_model);
+  if (!external.sr_weights.empty()) command += " --sr-weights " + external.sr_weights.string();
+  if (external.tiles.tile != priors::sr::kDefaultTiles.tile)
+    command += fmt::format(" --tile {}", external.tiles.tile);
+  if (external.depth_model != "none") command += " --depth-model " + external.depth_model;
+  if (!external.depth_weights.empty())
+    command += " --depth-weights " + external.depth_weights.string();
+  if (const auto& background = o.scene_options.background)
+    command +=
+        fmt::format(" --background {},{},{}", (*background)[0], (*background)[1], (*background)[2]);
+  if (o.scene_options.test_every != SceneOptions{}.test_every)
+    command += fmt::format(" --test-every {}", o.scene_options.test_every);
+  return command + " -o " + (o.output / "external").string();
+}
+
 // The HR rows take nearly all of a run's time: after each, where the run stands, with an ETA for
 // the rows left to train at the pace of those trained so far (a row reused from the cache takes
 // seconds, and is counted in neither).
@@ -210,9 +230,7 @@ void Pipeline::check_cached_inputs() const {
   if (any_row(Source::SuperResolved))
     require(external_stage_current(lr_scene_, *lr_images_, o_.external, o_.output / "external"),
             o_.output / "external", "external",
-            fmt::format("iesrgs external {} --downscale {} --scale {} -o {} or iesrgs run",
-                        o_.scene.string(), lr_scene_.downscale, o_.scale,
-                        (o_.output / "external").string()));
+            external_stage_command(o_, lr_scene_.downscale) + " or iesrgs run");
   if (rows_use_internal_references())
     require(internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
                                    o_.output / "internal"),

@@ -171,13 +171,16 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
 
 TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
-  const CliRun fuse = iesrgs("fuse " + scene + " -o " + out + kTinySchedule);
+  const CliRun fuse =
+      iesrgs("fuse " + scene + " -o " + out + " --background 0.5,0.5,0.5" + kTinySchedule);
   EXPECT_EQ(fuse.status, 1);
   EXPECT_TRUE(contains(last_line(fuse.output), "external: the external stage here is missing"))
       << fuse.output;
-  // The hint is a command that makes the stage this run wants: its scene and scale.
-  EXPECT_TRUE(contains(
-      fuse.output, "iesrgs external " + scene + " --downscale 4 --scale 4 -o " + out + "/external"))
+  // The hint is a command that makes the stage this run wants: its scene, scale and options.
+  EXPECT_TRUE(contains(fuse.output, "iesrgs external " + scene +
+                                        " --downscale 4 --scale 4 --sr-model bicubic --background "
+                                        "0.5,0.5,0.5 -o " +
+                                        out + "/external or iesrgs run"))
       << fuse.output;
   EXPECT_FALSE(std::filesystem::exists(out));  // refused: no empty run folder left behind
 
