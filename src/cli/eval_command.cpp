@@ -4,7 +4,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <map>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -48,30 +50,47 @@ std::vector<std::filesystem::path> render_files(std::filesystem::path dir) {
   return files;
 }
 
+// The background a render.json records, when it holds three numbers in [0, 1].
+std::optional<std::array<float, 3>> recorded_background(const nlohmann::json& report) {
+  const auto found = report.find("background");
+  if (found == report.end() || !found->is_array() || found->size() != 3) return std::nullopt;
+  std::array<float, 3> background{};
+  for (size_t c = 0; c < 3; ++c) {
+    const nlohmann::json& value = (*found)[c];
+    if (!value.is_number() || !(value.get<double>() >= 0 && value.get<double>() <= 1))
+      return std::nullopt;
+    background[c] = value.get<float>();
+  }
+  return background;
+}
+
 // Refuses a render that `iesrgs render` did not finish, and one of other cameras than the ground
 // truth's split, as its render.json records them: names alone do not tell (NeRF Synthetic's
-// splits both start at r_0).
-void check_render_record(const EvalArgs& args) {
+// splits both start at r_0). Returns the background the renders were drawn over, as recorded.
+std::optional<std::array<float, 3>> check_render_record(const EvalArgs& args) {
   std::filesystem::path folder = args.renders;
   if (!folder.has_filename()) folder = folder.parent_path();  // given as "out/rgb/"
   if (folder.filename() == "rgb" && !std::filesystem::exists(folder / "render.json"))
     folder = folder.parent_path();
   const std::filesystem::path record = folder / "render.json";
-  if (!std::filesystem::exists(record)) return;
+  if (!std::filesystem::exists(record)) return std::nullopt;
   const nlohmann::json report = nlohmann::json::parse(read_file(record), nullptr, false);
-  if (!report.is_object()) return;
+  if (!report.is_object()) return std::nullopt;
   if (const auto finished = report.find("finished"); finished != report.end() && *finished == false)
     fail_file(record, "this render did not finish: render again before scoring it");
-  if (!is_scene(args.ground_truth)) return;
-  if (report.contains("path"))
-    fail_file(record, "these renders are frames of a camera path, which have no ground truth");
-  const auto recorded = report.find("split");
-  if (recorded == report.end() || !recorded->is_string()) return;  // an older or edited record
-  const std::string split = recorded->get<std::string>();
-  if (split != args.split)
-    fail_file(record, fmt::format("these renders are of the {} split, and --split {} would score "
-                                  "them against other views of the same names; use --split {}",
-                                  split, args.split, split));
+  if (is_scene(args.ground_truth)) {
+    if (report.contains("path"))
+      fail_file(record, "these renders are frames of a camera path, which have no ground truth");
+    const auto recorded = report.find("split");
+    const std::string split = recorded != report.end() && recorded->is_string()
+                                  ? recorded->get<std::string>()
+                                  : args.split;  // an older or edited record
+    if (split != args.split)
+      fail_file(record, fmt::format("these renders are of the {} split, and --split {} would score "
+                                    "them against other views of the same names; use --split {}",
+                                    split, args.split, split));
+  }
+  return recorded_background(report);
 }
 
 // Ground truth for a render stem: a scene's camera of that name (at --downscale, composited over
@@ -136,11 +155,14 @@ class GroundTruth {
 };
 
 void run_eval(const EvalArgs& args) {
-  check_render_record(args);
+  const std::optional<std::array<float, 3>> rendered_over = check_render_record(args);
   SceneArgs scene_args;
   scene_args.options.downscale = args.downscale;
   scene_args.background = args.background;
-  GroundTruth truth(args, scene_args.resolved());
+  SceneOptions options = scene_args.resolved();
+  // The ground truth over the background the renders were drawn over, as 3DGS scores its renders.
+  if (!options.background) options.background = rendered_over;
+  GroundTruth truth(args, options);
   const eval::LoadedLpips lpips = eval::load_default_lpips(args.lpips);
   eval::MetricsReport report;
   report.lpips_status = lpips.status;
@@ -205,9 +227,10 @@ void add_eval_command(CLI::App& app) {
       ->capture_default_str();
   command
       ->add_option("--background", args->background,
-                   "Background for RGBA renders and ground truth: as a scene's (auto: white for "
-                   "NeRF Synthetic and for a plain folder, black for captures), white, black or "
-                   "r,g,b")
+                   "Background for RGBA renders and ground truth: white, black, r,g,b or auto "
+                   "(the one the renders were drawn over, which iesrgs render records, else as "
+                   "a scene's: white for NeRF Synthetic and for a plain folder, black for "
+                   "captures)")
       ->capture_default_str();
   add_lpips_option(*command, args->lpips);
   command->callback([args] { run_eval(*args); });

@@ -65,6 +65,9 @@ void print_model_summary(const std::filesystem::path& path) {
   fmt::print("3D filter   {}\n", cloud.has_filter_3d() ? "yes (Mip-Splatting)" : "no");
   fmt::print("2D filter   {}\n",
              cloud.antialiased ? "Mip-Splatting's (antialiased)" : "3DGS's dilation (classic)");
+  if (const auto& background = cloud.background)
+    fmt::print("background  {:.3g} {:.3g} {:.3g} (trained over)\n", (*background)[0],
+               (*background)[1], (*background)[2]);
   if (n == 0) return;
   Vec3 low{INFINITY, INFINITY, INFINITY}, high = -low;
   std::vector<double> opacity(n), largest_scale(n);

@@ -2,6 +2,7 @@
 // (--scale 4 renders four times the cameras' resolution with the same field of view), or along a
 // camera path made from the training cameras (--path orbit | interp).
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <string>
@@ -93,11 +94,13 @@ void require_render_sizes(const std::vector<Camera>& cameras, double scale,
 
 void run_render(const RenderArgs& args) {
   use_device(args.device);
-  gs::GaussianModel model =
-      gs::model_from_splat_cloud(read_model(train::trained_model_file(args.model)))
-          .to(compute_device());
+  const SplatCloud cloud = read_model(train::trained_model_file(args.model));
+  gs::GaussianModel model = gs::model_from_splat_cloud(cloud).to(compute_device());
   if (args.rasterize_mode != "auto") model.antialiased = args.rasterize_mode == "antialiased";
-  const Scene scene = load_scene(args.scene.path, args.scene.resolved());
+  SceneOptions scene_options = args.scene.resolved();
+  // As 3DGS renders: over the background the model was trained over, where it is known.
+  if (!scene_options.background) scene_options.background = cloud.background;
+  const Scene scene = load_scene(args.scene.path, scene_options);
   const std::string what = args.path.empty() ? args.split : args.path + " path";
   std::vector<Camera> cameras;
   if (args.path.empty()) {
@@ -121,8 +124,8 @@ void run_render(const RenderArgs& args) {
   // Two renders into one folder would leave a mix of two models' views.
   const FolderLock lock(args.output);
   const char* mode = model.antialiased ? "antialiased" : "classic";
-  fmt::print("rendering {} {} views of {} Gaussians at x{} ({})\n", cameras.size(), what,
-             model.size(), args.scale, mode);
+  fmt::print("rendering {} {} views of {} Gaussians at x{} ({}, background {})\n", cameras.size(),
+             what, model.size(), args.scale, mode, fmt::join(scene.background, ","));
   std::vector<std::string> names;
   for (const Camera& camera : cameras) names.push_back(camera.name);
   remove_earlier_render(args.output, names);
@@ -131,6 +134,7 @@ void run_render(const RenderArgs& args) {
                            {"height", first.intrinsics.height},
                            {"gaussians", model.size()},
                            {"rasterize_mode", mode},
+                           {"background", scene.background},
                            {"names", names},
                            {"finished", false}};
   // What eval checks its ground truth against.
@@ -161,6 +165,11 @@ void add_render_command(CLI::App& app) {
       ->add_option("model", args->model, "Training output folder, a 3DGS .ply, an .spz or a .splat")
       ->required();
   args->scene.add_to(*command);
+  command->get_option("--background")
+      ->description(
+          "Background behind the model: white, black, r,g,b in [0,1], or auto (the one the model "
+          "was trained over, which a .ply of iesrgs records, else white for NeRF Synthetic "
+          "scenes and black for captures, as 3DGS)");
   command->add_option("-o,--output", args->output, "Output folder (rgb/, depth/, alpha/)")
       ->required()
       ->check(kNonEmptyPath);

@@ -125,7 +125,7 @@ void run_train(const TrainArgs& args) {
   }
   const train::TrainSummary summary = trainer.run();
   if (summary.interrupted) throw Interrupted("continue with the same command and --resume");
-  train::write_point_clouds(out, trainer.model());
+  train::write_point_clouds(out, trainer);
 
   const nlohmann::json report = {
       {"scene", scene.root.string()},

@@ -29,6 +29,7 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
 constexpr int kMaxShDegree = 3;
 constexpr std::string_view kRestPrefix = "f_rest_";
 constexpr char kFilterName[] = "filter_3D";
+constexpr std::string_view kBackgroundComment = "background";
 
 size_t rest_per_channel(int sh_degree) {
   return size_t((sh_degree + 1) * (sh_degree + 1) - 1);
@@ -85,9 +86,12 @@ std::vector<Slot> checked_layout(const SplatCloud& cloud, const fs::path& path) 
   return slots;
 }
 
-std::string header_text(size_t count, const std::vector<Slot>& slots) {
-  std::string text =
-      fmt::format("ply\nformat binary_little_endian 1.0\nelement vertex {}\n", count);
+std::string header_text(const SplatCloud& cloud, const std::vector<Slot>& slots) {
+  std::string text = "ply\nformat binary_little_endian 1.0\n";
+  if (const auto& background = cloud.background)
+    text += fmt::format("comment {} {} {} {}\n", kBackgroundComment, (*background)[0],
+                        (*background)[1], (*background)[2]);
+  text += fmt::format("element vertex {}\n", cloud.size());
   for (const Slot& slot : slots) text += "property float " + slot.name + "\n";
   return text + "end_header\n";
 }
@@ -198,6 +202,7 @@ struct Property {
 
 struct Header {
   bool ascii = false;
+  std::optional<std::array<float, 3>> background;
   uint64_t vertex_count = 0;
   std::vector<Property> properties;  // of the vertex element
   size_t body_offset = 0;
@@ -234,6 +239,7 @@ class HeaderParser {
       fail_file(name_, "not a PLY file (the first line is not 'ply')");
     while (true) {
       const std::vector<std::string_view> words = next_line();
+      if (!words.empty() && words[0] == "comment") parse_comment(words);
       if (words.empty() || words[0] == "comment" || words[0] == "obj_info") continue;
       if (words[0] == "end_header") break;
       if (words[0] == "format") {
@@ -264,6 +270,19 @@ class HeaderParser {
 
   [[noreturn]] void fail_line(const std::string& problem) const {
     fail_file(name_, fmt::format("header line {}: {}", line_number_, problem));
+  }
+
+  // "comment background r g b" with each in [0, 1]; any other comment, this one malformed
+  // included, is a remark for people and skipped as other readers skip it.
+  void parse_comment(const std::vector<std::string_view>& words) {
+    if (words.size() != 5 || words[1] != kBackgroundComment) return;
+    std::array<float, 3> background{};
+    for (size_t c = 0; c < 3; ++c) {
+      const char* end = words[2 + c].data() + words[2 + c].size();
+      const auto [ptr, ec] = std::from_chars(words[2 + c].data(), end, background[c]);
+      if (ec != std::errc() || ptr != end || !(background[c] >= 0 && background[c] <= 1)) return;
+    }
+    header_.background = background;
   }
 
   void parse_format(const std::vector<std::string_view>& words) {
@@ -432,7 +451,7 @@ void write_ply(const fs::path& path, const SplatCloud& cloud) {
   const std::vector<Slot> slots = checked_layout(cloud, path);
   write_atomically(path, [&](const fs::path& tmp) {
     std::ofstream out(tmp, std::ios::binary);
-    out << header_text(cloud.size(), slots);
+    out << header_text(cloud, slots);
     write_body(out, cloud, slots, path);
     out.close();
     if (!out) fail_file(path, "write failed (disk full or not writable?)");
@@ -484,6 +503,7 @@ SplatCloud parse_ply(std::string_view bytes, const fs::path& name) {
   else
     read_body(BinaryValues(body), header, targets, cloud, name);
   cloud.antialiased = has_filter;
+  cloud.background = header.background;
   return cloud;
 }
 

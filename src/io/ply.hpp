@@ -1,8 +1,10 @@
 #pragma once
 // Gaussian splat scenes as standard 3DGS .ply files (one "vertex" element, one float property per
 // stored parameter), the layout that 3DGS, Mip-Splatting and every splat viewer read and write.
+#include <array>
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -21,13 +23,18 @@ struct SplatCloud {
   // Trained with Mip-Splatting's 2D mip filter, which renderers must then use; false for 3DGS's
   // dilation. Kept when the 3D filter is baked.
   bool antialiased = true;
+  // The background the model was trained over, which renders default to: 3DGS keeps it in the
+  // model folder's cfg_args, a .ply in a "comment background r g b" header line that other readers
+  // skip. Unset for a file without that line.
+  std::optional<std::array<float, 3>> background;
 
   size_t size() const { return positions.size() / 3; }
   bool has_filter_3d() const { return !filter_3d.empty(); }
 };
 
 // binary_little_endian float32 in 3DGS's property order: x y z nx ny nz f_dc_0..2 f_rest_*
-// opacity scale_0..2 rot_0..3, then Mip-Splatting's filter_3D when present. Normals are written as
+// opacity scale_0..2 rot_0..3, then Mip-Splatting's filter_3D when present; the background as a
+// comment when set. Normals are written as
 // zeros and f_rest channel-major (all R coefficients, then G, then B), as 3DGS flattens its
 // transposed tensor. Written atomically; throws Error naming the file when the arrays disagree in
 // size or hold a non-finite value.

@@ -74,7 +74,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
     throw Interrupted(
         fmt::format("{} stopped at iteration {}; run the same command again to resume", name,
                     summary.iterations));
-  train::write_point_clouds(dir, trainer->model());
+  train::write_point_clouds(dir, *trainer);
   const double seconds = finished_seconds.value_or(summary.seconds);
   record_stage(dir, identity, true, seconds);
   fmt::print("{}: {} Gaussians after {} ({:.2f} it/s)\n", name, summary.gaussians,

@@ -80,8 +80,9 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
                                    box.center);
 }
 
-void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianModel& model) {
-  const SplatCloud cloud = gs::to_splat_cloud(model);
+void write_point_clouds(const std::filesystem::path& dir, const Trainer& trainer) {
+  SplatCloud cloud = gs::to_splat_cloud(trainer.model());
+  cloud.background = trainer.background();
   write_ply_filter_baked(dir / "point_cloud_filter_baked.ply", cloud);
   write_ply(model_path(dir), cloud);
 }

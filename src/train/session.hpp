@@ -41,9 +41,10 @@ gs::GaussianModel initial_model(const Scene& scene, const TrainConfig& config,
 
 // <dir>/point_cloud.ply (3DGS layout plus the Mip-Splatting filter_3D property) and
 // <dir>/point_cloud_filter_baked.ply (the filter folded into scale and opacity, for viewers that
-// do not know it), both written atomically; the model last, since it tells a finished training
-// (a process killed between the two leaves a training to resume).
-void write_point_clouds(const std::filesystem::path& dir, const gs::GaussianModel& model);
+// do not know it), both written atomically, of the trainer's model and with the background it
+// trains over; the model last, since it tells a finished training (a process killed between the
+// two leaves a training to resume).
+void write_point_clouds(const std::filesystem::path& dir, const Trainer& trainer);
 
 // Removes what an earlier training left in `dir` (checkpoint, log, point clouds, summary), before
 // a new run there: --resume would otherwise continue the earlier checkpoint under the new

@@ -88,6 +88,7 @@ class Trainer {
 
   // On the training device (core/device.hpp).
   const gs::GaussianModel& model() const { return model_; }
+  const std::array<float, 3>& background() const { return setup_.background; }
   std::filesystem::path checkpoint_path() const {
     return train::checkpoint_path(setup_.output_dir);
   }

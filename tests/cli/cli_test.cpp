@@ -278,6 +278,7 @@ TEST(Cli, InfoOfAModelSummarizesItsGaussians) {
   cloud.opacity = {0, 0};
   cloud.log_scales = {0, -1, -2, 0, 0, 0};
   cloud.rotations = {1, 0, 0, 0, 1, 0, 0, 0};
+  cloud.background = std::array<float, 3>{0, 0.5f, 1};
   write_ply(dir / "model.ply", cloud);
   const CliRun run = iesrgs("info " + (dir / "model.ply").string());
   EXPECT_EQ(run.status, 0) << run.output;
@@ -285,6 +286,7 @@ TEST(Cli, InfoOfAModelSummarizesItsGaussians) {
   EXPECT_TRUE(contains(run.output, "(-1.000, -4.000, 2.000) to (3.000, 0.000, 5.000)"))
       << run.output;
   EXPECT_TRUE(contains(run.output, "opacity     median 0.500")) << run.output;
+  EXPECT_TRUE(contains(run.output, "background  0 0.5 1 (trained over)")) << run.output;
 
   // A training folder is summarized by its point_cloud.ply.
   std::filesystem::create_directories(dir / "run");
@@ -308,6 +310,12 @@ TEST(Cli, EvalCompositesRgbaRendersOverTheBackground) {
   const CliRun on_black = iesrgs("eval --lpips none --background black " + folders);
   EXPECT_EQ(on_black.status, 0) << on_black.output;
   EXPECT_TRUE(contains(on_black.output, "1 views: PSNR 0.000 dB")) << on_black.output;
+  // By default, the background the renders were drawn over, as their render.json records it.
+  write_text(dir / "renders" / "render.json", R"({"finished": true, "background": [0, 0, 0]})");
+  const CliRun recorded = iesrgs("eval --lpips none " + folders);
+  EXPECT_EQ(recorded.status, 0) << recorded.output;
+  EXPECT_TRUE(contains(recorded.output, "1 views: PSNR 0.000 dB")) << recorded.output;
+  std::filesystem::remove(dir / "renders" / "render.json");
 
   // Against a capture, the scene's background (black): the held-out photo, with white
   // transparent pixels where it shows the background, scores as the photo itself.

@@ -173,11 +173,11 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   const CliRun rendered =
       iesrgs("render " + spz.string() + " " + scene + " -o " + (dir / "from_spz").string());
   ASSERT_EQ(rendered.status, 0) << rendered.output;
-  EXPECT_TRUE(contains(rendered.output, "(antialiased)")) << rendered.output;
+  EXPECT_TRUE(contains(rendered.output, "(antialiased, ")) << rendered.output;
   const CliRun classic = iesrgs("render " + spz.string() + " " + scene + " -o " +
                                 (dir / "classic").string() + " --rasterize-mode classic");
   ASSERT_EQ(classic.status, 0) << classic.output;
-  EXPECT_TRUE(contains(classic.output, "(classic)")) << classic.output;
+  EXPECT_TRUE(contains(classic.output, "(classic, ")) << classic.output;
   EXPECT_NE(read_image8(dir / "classic" / "rgb" / "r_0.png").data,
             read_image8(dir / "from_spz" / "rgb" / "r_0.png").data);
   // Quantized to a byte or so per value, the model renders as the .ply does to a few levels.
@@ -192,6 +192,41 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   EXPECT_EQ(unknown.status, 1);
   EXPECT_TRUE(contains(last_line(unknown.output), "scene.obj: unknown export format"))
       << unknown.output;
+}
+
+// As 3DGS's render and metrics scripts: a model is drawn over the background it was trained over,
+// and its renders scored against ground truth composited over the same.
+TEST(TrainCli, RenderAndEvalTakeTheTrainingBackground) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 4 --test-views 1 --seed 2").status, 0);
+  ASSERT_EQ(iesrgs("train " + scene + " -o " + out +
+                   " --background black --preset fast --iterations 10 --set random_points=500"
+                   " --set init=random")
+                .status,
+            0);
+  const auto mean_psnr = [&](const std::string& renders, const std::string& options) {
+    const CliRun eval = iesrgs("eval --lpips none " + options + " " + renders + " " + scene);
+    EXPECT_EQ(eval.status, 0) << eval.output;
+    return nlohmann::json::parse(read_file(std::filesystem::path(renders) / "metrics.json"))
+        .at("mean")
+        .at("psnr")
+        .get<double>();
+  };
+  const std::string renders = (dir / "renders").string();
+  const CliRun render = iesrgs("render " + out + " " + scene + " -o " + renders);
+  ASSERT_EQ(render.status, 0) << render.output;
+  EXPECT_TRUE(contains(render.output, "background 0,0,0)")) << render.output;
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir / "renders" / "render.json"))["background"],
+            nlohmann::json::array({0, 0, 0}));
+  const double on_black = mean_psnr(renders, "--background black");
+  EXPECT_EQ(mean_psnr(renders, ""), on_black);
+  EXPECT_NE(mean_psnr(renders, "--background white"), on_black);
+
+  const CliRun white =
+      iesrgs("render " + out + " " + scene + " -o " + renders + " --background white");
+  ASSERT_EQ(white.status, 0) << white.output;
+  EXPECT_TRUE(contains(white.output, "background 1,1,1)")) << white.output;
 }
 
 TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {

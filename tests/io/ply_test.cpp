@@ -210,6 +210,33 @@ std::string patched(const std::string& bytes, const std::string& from, const std
   return at == std::string::npos ? result : result.replace(at, from.size(), to);
 }
 
+TEST(Ply, TheTrainingBackgroundRoundTripsAsAComment) {
+  TempDir dir;
+  SplatCloud cloud = make_cloud(0, 2, true);
+  EXPECT_FALSE(cloud.background.has_value());
+  write_ply(dir / "plain.ply", cloud);
+  EXPECT_FALSE(read_ply(dir / "plain.ply").background.has_value());
+
+  cloud.background = std::array<float, 3>{0.1f, 0.5f, 1};
+  write_ply(dir / "gray.ply", cloud);
+  const std::string bytes = read_file(dir / "gray.ply");
+  EXPECT_NE(header_of(bytes).find("\ncomment background 0.1 0.5 1\nelement vertex 2\n"),
+            std::string::npos);
+  EXPECT_EQ(read_ply(dir / "gray.ply").background, cloud.background);
+  write_ply_filter_baked(dir / "baked.ply", cloud);
+  EXPECT_EQ(read_ply(dir / "baked.ply").background, cloud.background);
+
+  // Comments are for people: one that is not a background in [0, 1] is skipped, not refused.
+  for (const char* comment :
+       {"background 0.1 0.5", "background 0.1 0.5 2", "background a b c", "made by hand"}) {
+    SCOPED_TRACE(comment);
+    write_text(dir / "odd.ply", patched(bytes, "background 0.1 0.5 1", comment));
+    const SplatCloud odd = read_ply(dir / "odd.ply");
+    EXPECT_FALSE(odd.background.has_value());
+    expect_same(odd, cloud);
+  }
+}
+
 // Ascii files with one vertex element of `count` Gaussians (degree 0) and the given data lines.
 std::string ascii_ply(const std::string& count, const std::string& data) {
   return "ply\nformat ascii 1.0\nelement vertex " + count +

@@ -381,13 +381,17 @@ TEST_F(TrainerTest, PruningEveryGaussianStopsTraining) {
 
 TEST_F(TrainerTest, PointCloudsRoundTripThroughPly) {
   TempDir out;
-  Trainer trainer(config(), setup(out.path()), initial());
+  TrainerSetup gray = setup(out.path());
+  gray.background = {0.25f, 0.5f, 0.75f};
+  Trainer trainer(config(), std::move(gray), initial());
   trainer.run();
-  write_point_clouds(out.path(), trainer.model());
-  const gs::GaussianModel back = gs::model_from_splat_cloud(read_ply(out / "point_cloud.ply"));
+  write_point_clouds(out.path(), trainer);
+  const SplatCloud cloud = read_ply(out / "point_cloud.ply");
+  const gs::GaussianModel back = gs::model_from_splat_cloud(cloud);
   EXPECT_LT(max_difference(back, trainer.model()), 1e-6);
-  EXPECT_TRUE(std::filesystem::exists(out / "point_cloud_filter_baked.ply"));
   EXPECT_TRUE(back.antialiased);
+  EXPECT_EQ(cloud.background, trainer.background());  // what render then draws behind it
+  EXPECT_EQ(read_ply(out / "point_cloud_filter_baked.ply").background, trainer.background());
 }
 
 // A 3DGS model as the start (drawn with the dilation) still trains as Mip-Splatting.
