@@ -2,6 +2,10 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include <string>
+#include <vector>
 
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
@@ -27,15 +31,31 @@ nlohmann::json stage_json(const std::filesystem::path& dir) {
   return typed ? record : nlohmann::json::object();
 }
 
+// Whether the record is of these parameters. When it is of others, says which at debug level
+// (iesrgs -v): why a stage is made again is otherwise a guess.
+bool params_match(const std::filesystem::path& dir, const nlohmann::json& record,
+                  const nlohmann::json& params) {
+  const nlohmann::json recorded = record.value("params", nlohmann::json());
+  if (recorded == params) return true;
+  if (!recorded.is_null()) {
+    std::vector<std::string> changed;
+    for (const nlohmann::json& operation : nlohmann::json::diff(recorded, params))
+      changed.push_back(operation.value("path", ""));
+    spdlog::debug("{}: recorded with other parameters ({})", (dir / "stage.json").string(),
+                  fmt::join(changed, ", "));
+  }
+  return false;
+}
+
 }  // namespace
 
 bool stage_recorded(const std::filesystem::path& dir, const nlohmann::json& params) {
-  return stage_json(dir).value("params", nlohmann::json()) == params;
+  return params_match(dir, stage_json(dir), params);
 }
 
 bool stage_finished(const std::filesystem::path& dir, const nlohmann::json& params) {
   const nlohmann::json record = stage_json(dir);
-  return record.value("params", nlohmann::json()) == params && record.value("finished", false);
+  return params_match(dir, record, params) && record.value("finished", false);
 }
 
 double stage_seconds(const std::filesystem::path& dir) {

@@ -317,6 +317,8 @@ void Trainer::refine(int64_t iteration) {
       options.max_gaussians = densify_cap();
       const gs::DensifyCounts counts =
           gs::densify_and_prune(model_, *optimizer_, stats_, options, setup_.scene_extent);
+      spdlog::debug("iteration {}: densification cloned {}, split {}, pruned {}: {} Gaussians",
+                    iteration, counts.cloned, counts.split, counts.pruned, model_.size());
       if (counts.held_back > 0) warn_memory_cap(iteration, options.max_gaussians, counts.held_back);
       // An empty model would train on to an empty point cloud, which no command reads.
       if (model_.size() == 0)
@@ -327,8 +329,10 @@ void Trainer::refine(int64_t iteration) {
       gs::update_filter_3d(model_, train_cameras_);
     }
     const bool white = setup_.background == std::array<float, 3>{1, 1, 1};
-    if (iteration % c.opacity_reset_every == 0 || (white && iteration == c.densify_from))
+    if (iteration % c.opacity_reset_every == 0 || (white && iteration == c.densify_from)) {
       gs::reset_opacity(model_, *optimizer_);
+      spdlog::debug("iteration {}: opacities reset", iteration);
+    }
   } else if (iteration > c.densify_until && iteration % c.filter_update_every == 0 &&
              iteration < c.iterations - 100) {
     // As Mip-Splatting: keep the filter current after densification, but not in the last steps.

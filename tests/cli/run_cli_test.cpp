@@ -155,8 +155,13 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   EXPECT_TRUE(contains(read_file(dir / "run" / "results.md"), "from an earlier run"));
 
   // Another internal model: the rows built on it leave the table, the others stay (fuse too).
-  const CliRun other = iesrgs("fuse " + external_args + " --internal-set seed=7");
+  const CliRun other = iesrgs("-v fuse " + external_args + " --internal-set seed=7");
   ASSERT_EQ(other.status, 0) << other.output;
+  // With -v, why the stage is made again.
+  EXPECT_TRUE(contains(other.output,
+                       "internal/stage.json: recorded with other parameters "
+                       "(/training/seed)"))
+      << other.output;
   const Table independent = {{"bicubic", true}, {"external", false}, {"hr", true}};
   EXPECT_EQ(table(), independent);
 

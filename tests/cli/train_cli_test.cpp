@@ -229,6 +229,22 @@ TEST(TrainCli, RenderAndEvalTakeTheTrainingBackground) {
   EXPECT_TRUE(contains(white.output, "background 1,1,1)")) << white.output;
 }
 
+TEST(TrainCli, VerboseSaysWhatDensificationDoes) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 4 --test-views 1 --seed 2").status, 0);
+  // 400 iterations: densification from 7 until 200, every 100 iterations, so once.
+  const std::string train = "train " + scene + " -o " + (dir / "run").string() +
+                            " --preset fast --iterations 400 --set random_points=500";
+  const CliRun verbose = iesrgs("-v " + train);
+  ASSERT_EQ(verbose.status, 0) << verbose.output;
+  EXPECT_TRUE(contains(verbose.output, "iteration 100: densification cloned ")) << verbose.output;
+  EXPECT_TRUE(contains(verbose.output, "iteration 40: opacities reset")) << verbose.output;
+  const CliRun quiet = iesrgs(train);
+  ASSERT_EQ(quiet.status, 0) << quiet.output;
+  EXPECT_FALSE(contains(quiet.output, "densification")) << quiet.output;
+}
+
 TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
   TempDir dir;
   const std::string scene = (dir / "scene").string(), out = (dir / "run").string();
