@@ -31,7 +31,8 @@ std::vector<size_t> evenly_spaced(size_t total, size_t count) {
 }
 
 Mat3 quat_to_rotation(double w, double x, double y, double z) {
-  const Mat3T<double> rotation = unit_quat_to_rotation(w, x, y, z);
+  const double norm = std::sqrt(w * w + x * x + y * y + z * z);
+  const Mat3T<double> rotation = unit_quat_to_rotation(w / norm, x / norm, y / norm, z / norm);
   Mat3 r;
   for (int row = 0; row < 3; ++row)
     for (int column = 0; column < 3; ++column) r(row, column) = rotation.m[row][column];

@@ -91,7 +91,8 @@ double median(std::vector<double> values);
 // the first: i * total / count.
 std::vector<size_t> evenly_spaced(size_t total, size_t count);
 
-// Rotation matrix from a unit quaternion (w, x, y, z), as COLMAP stores it.
+// Rotation matrix of the quaternion (w, x, y, z), normalized first as COLMAP does on read; the
+// caller checks that it has a length.
 Mat3 quat_to_rotation(double w, double x, double y, double z);
 
 // Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method, numerically stable).

@@ -172,9 +172,7 @@ Camera camera_of(const ColmapImage& image, const Lens& lens, const fs::path& roo
   camera.stored = lens.intrinsics;
   camera.intrinsics = lens.intrinsics;
   camera.distortion = lens.distortion;
-  // COLMAP normalizes quaternions on read; so do we.
-  camera.rotation =
-      quat_to_rotation(image.qw / norm, image.qx / norm, image.qy / norm, image.qz / norm);
+  camera.rotation = quat_to_rotation(image.qw, image.qx, image.qy, image.qz);
   camera.translation = {image.tx, image.ty, image.tz};
   return camera;
 }

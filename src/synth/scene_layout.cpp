@@ -77,13 +77,8 @@ Sphere resting_sphere(double x, double y, double radius) {
 // Rotation from a random (not uniformly distributed, which does not matter here) quaternion.
 Mat3 random_rotation(Rng& rng) {
   std::array<double, 4> q;
-  double norm2 = 0;
-  for (double& c : q) {
-    c = rng.uniform(-1, 1);
-    norm2 += c * c;
-  }
-  const double n = std::sqrt(norm2);
-  return quat_to_rotation(q[0] / n, q[1] / n, q[2] / n, q[3] / n);
+  for (double& c : q) c = rng.uniform(-1, 1);
+  return quat_to_rotation(q[0], q[1], q[2], q[3]);
 }
 
 template <typename T, size_t N>

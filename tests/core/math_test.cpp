@@ -24,6 +24,14 @@ TEST(Math, QuaternionRoundTrip) {
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(back[i], q[i], 1e-12);
 }
 
+TEST(Math, QuaternionIsNormalizedFirst) {
+  // Twice a unit quaternion: the same rotation, as COLMAP reads it (and as the kernels' own).
+  const Mat3 unit = quat_to_rotation(0.5, 0.5, -0.5, 0.5);
+  const Mat3 doubled = quat_to_rotation(1, 1, -1, 1);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) EXPECT_EQ(doubled(i, j), unit(i, j));
+}
+
 TEST(Math, QuaternionOfEveryBranch) {
   // 180-degree turns about each axis exercise the branches where the trace is not positive.
   for (const auto& q :
