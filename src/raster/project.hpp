@@ -247,6 +247,65 @@ IESRGS_HD void splat_rect(const Splat<T>& s, const Sym2<T>& filtered, int width,
   splat_rect(true, b, rect, radius);
 }
 
+// cov = (J W) sigma (J W)^T, with g2 the gradient of cov as a symmetric matrix (its off-diagonal
+// entry halved): dsigma = (J W)^T g2 (J W), d(J W) = 2 g2 (J W) sigma.
+template <typename T>
+IESRGS_HD void projected_covariance_backward(const Projection<T>& p, const T (&g2)[2][2],
+                                             Mat3T<T>& dsigma, T (&djw)[2][3]) {
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      T s = 0;
+      for (int r = 0; r < 2; ++r)
+        for (int c = 0; c < 2; ++c) s += p.jw[r][a] * g2[r][c] * p.jw[c][b];
+      dsigma.m[a][b] = s;
+    }
+  for (int r = 0; r < 2; ++r)
+    for (int b = 0; b < 3; ++b) {
+      T s = 0;
+      for (int c = 0; c < 2; ++c)
+        for (int a = 0; a < 3; ++a) s += g2[r][c] * p.jw[c][a] * p.sigma.m[a][b];
+      djw[r][b] = T(2) * s;
+    }
+}
+
+// J W: dJ = d(J W) W^T, of which only J00, J02, J11, J12 are nonzero, added to the gradient of
+// the view-space position J depends on.
+template <typename T>
+IESRGS_HD void jacobian_backward(const Projection<T>& p, const RasterCamera<T>& cam,
+                                 const Mat3T<T>& w, const T (&djw)[2][3], Vec3T<T>& dview) {
+  T dj[2][3];
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 3; ++c)
+      dj[r][c] = djw[r][0] * w.m[c][0] + djw[r][1] * w.m[c][1] + djw[r][2] * w.m[c][2];
+  const T z = p.view.z, z2 = z * z, z3 = z2 * z;
+  dview.z += -cam.fx / z2 * dj[0][0] - cam.fy / z2 * dj[1][1] +
+             T(2) * cam.fx * p.tx / z3 * dj[0][2] + T(2) * cam.fy * p.ty / z3 * dj[1][2];
+  const T dtx = -cam.fx / z2 * dj[0][2], dty = -cam.fy / z2 * dj[1][2];
+  // tx = z * clamp(x / z): the clamped ratio is constant, so tx then scales with z.
+  dview.z += hd::select(p.clamped_x, dtx * p.tx / z, T(0));
+  dview.x += hd::select(p.clamped_x, T(0), dtx);
+  dview.z += hd::select(p.clamped_y, dty * p.ty / z, T(0));
+  dview.y += hd::select(p.clamped_y, T(0), dty);
+}
+
+// sigma = R diag(var) R^T: dvar_k = (R^T dsigma R)_kk, dR = 2 dsigma R diag(var).
+template <typename T>
+IESRGS_HD void covariance_backward(const Projection<T>& p, const Mat3T<T>& dsigma, T (&dvar)[3],
+                                   Mat3T<T>& drot) {
+  for (int k = 0; k < 3; ++k) {
+    T s = 0;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) s += p.rot.m[a][k] * dsigma.m[a][b] * p.rot.m[b][k];
+    dvar[k] = s;
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int k = 0; k < 3; ++k) {
+      T s = 0;
+      for (int b = 0; b < 3; ++b) s += dsigma.m[a][b] * p.rot.m[b][k];
+      drot.m[a][k] = T(2) * s * p.var[k];
+    }
+}
+
 // The gradient of one Gaussian (or one per lane) given the gradient of its splat; false where it
 // is culled, which gets no gradient. Branch-free like project().
 template <typename T>
@@ -277,53 +336,14 @@ IESRGS_HD hd::Mask<T> project_backward(const GaussianRow<T>& g, const RasterCame
   const Sym2<T> dcov = gs::filter2d_backward(p.cov, g.antialiased, dfiltered, dopacity2d);
   const T g2[2][2] = {{dcov.xx, T(0.5) * dcov.xy}, {T(0.5) * dcov.xy, dcov.yy}};
 
-  // cov = (J W) sigma (J W)^T: dsigma = (J W)^T g2 (J W), d(J W) = 2 g2 (J W) sigma.
+  // Covariance -> J W and sigma; J W -> view-space position; sigma -> scales and rotation.
   Mat3T<T> dsigma;
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) {
-      T s = 0;
-      for (int r = 0; r < 2; ++r)
-        for (int c = 0; c < 2; ++c) s += p.jw[r][a] * g2[r][c] * p.jw[c][b];
-      dsigma.m[a][b] = s;
-    }
   T djw[2][3];
-  for (int r = 0; r < 2; ++r)
-    for (int b = 0; b < 3; ++b) {
-      T s = 0;
-      for (int c = 0; c < 2; ++c)
-        for (int a = 0; a < 3; ++a) s += g2[r][c] * p.jw[c][a] * p.sigma.m[a][b];
-      djw[r][b] = T(2) * s;
-    }
-  // J W: dJ = d(J W) W^T; only J00, J02, J11, J12 are nonzero.
-  T dj[2][3];
-  for (int r = 0; r < 2; ++r)
-    for (int c = 0; c < 3; ++c)
-      dj[r][c] = djw[r][0] * w.m[c][0] + djw[r][1] * w.m[c][1] + djw[r][2] * w.m[c][2];
-  const T z2 = z * z, z3 = z2 * z;
-  dview.z += -cam.fx / z2 * dj[0][0] - cam.fy / z2 * dj[1][1] +
-             T(2) * cam.fx * p.tx / z3 * dj[0][2] + T(2) * cam.fy * p.ty / z3 * dj[1][2];
-  const T dtx = -cam.fx / z2 * dj[0][2], dty = -cam.fy / z2 * dj[1][2];
-  // tx = z * clamp(x / z): the clamped ratio is constant, so tx then scales with z.
-  dview.z += hd::select(p.clamped_x, dtx * p.tx / z, T(0));
-  dview.x += hd::select(p.clamped_x, T(0), dtx);
-  dview.z += hd::select(p.clamped_y, dty * p.ty / z, T(0));
-  dview.y += hd::select(p.clamped_y, T(0), dty);
-
-  // sigma = R diag(var) R^T: dvar_k = (R^T dsigma R)_kk, dR = 2 dsigma R diag(var).
+  projected_covariance_backward(p, g2, dsigma, djw);
+  jacobian_backward(p, cam, w, djw, dview);
   T dvar[3];
   Mat3T<T> drot;
-  for (int k = 0; k < 3; ++k) {
-    T s = 0;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) s += p.rot.m[a][k] * dsigma.m[a][b] * p.rot.m[b][k];
-    dvar[k] = s;
-  }
-  for (int a = 0; a < 3; ++a)
-    for (int k = 0; k < 3; ++k) {
-      T s = 0;
-      for (int b = 0; b < 3; ++b) s += dsigma.m[a][b] * p.rot.m[b][k];
-      drot.m[a][k] = T(2) * s * p.var[k];
-    }
+  covariance_backward(p, dsigma, dvar, drot);
   gs::filter3d_backward(p.scale, g.filter_std, dvar, dopacity3d, out.log_scale);
   quat_to_rotation_backward(g.quat, drot, out.quat);
 
