@@ -2,6 +2,7 @@
 // (compressed, with the view-dependent colour), or a .ply with Mip-Splatting's 3D filter baked
 // in for any 3DGS viewer.
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include "cli/commands.hpp"
 #include "core/error.hpp"
@@ -43,6 +44,11 @@ void run_export(const ExportArgs& args) {
     write_ply_filter_baked(output, cloud);
   fmt::print("wrote {} Gaussians to {} ({} bytes)\n", written, output.string(),
              std::filesystem::file_size(output));
+  if (cloud.background && format != ".ply")
+    fmt::print(
+        "note: a {} file has no place for the background the model was trained over; "
+        "render it with --background {}\n",
+        format, fmt::join(*cloud.background, ","));
 }
 
 }  // namespace

@@ -120,7 +120,6 @@ void run_render(const RenderArgs& args) {
   require_render_sizes(cameras, args.scale, scene.root);
   // Before anything of an earlier render is removed.
   pipeline::require_render_memory(cameras, args.scale);
-  const Camera first = cameras.front().scaled(args.scale);
   // Two renders into one folder would leave a mix of two models' views.
   const FolderLock lock(args.output);
   const char* mode = model.antialiased ? "antialiased" : "classic";
@@ -129,31 +128,14 @@ void run_render(const RenderArgs& args) {
   std::vector<std::string> names;
   for (const Camera& camera : cameras) names.push_back(camera.name);
   remove_earlier_render(args.output, names);
-  nlohmann::json report = {{"views", cameras.size()},
-                           {"width", first.intrinsics.width},
-                           {"height", first.intrinsics.height},
-                           {"gaussians", model.size()},
-                           {"rasterize_mode", mode},
-                           {"background", scene.background},
-                           {"names", names},
-                           {"finished", false}};
-  // What eval checks its ground truth against.
-  if (args.path.empty())
-    report["split"] = args.split;
-  else
-    report["path"] = args.path;
-  // Recorded first, so that a render stopped partway is known for one (eval refuses it) and the
-  // next render into the folder removes its views.
-  const std::filesystem::path record = std::filesystem::path(args.output) / "render.json";
-  write_file_atomically(record, report.dump(2) + "\n");
-  const double seconds =
-      pipeline::render_views_to(args.output, model, cameras, scene.background, args.scale);
-  const double fps = pipeline::frames_per_second(seconds);
-  report["seconds_per_view"] = seconds;
-  report["fps"] = fps;
-  report["finished"] = true;
-  write_file_atomically(record, report.dump(2) + "\n");
-  fmt::print("{:.1f} ms per view ({:.1f} FPS); wrote {}\n", seconds * 1e3, fps, args.output);
+  // What eval checks its ground truth against; a stopped render's views are the next one's to
+  // remove.
+  const nlohmann::json record = args.path.empty() ? nlohmann::json{{"split", args.split}}
+                                                  : nlohmann::json{{"path", args.path}};
+  const double seconds = pipeline::render_views_recorded(args.output, model, cameras,
+                                                         scene.background, args.scale, record);
+  fmt::print("{:.1f} ms per view ({:.1f} FPS); wrote {}\n", seconds * 1e3,
+             pipeline::frames_per_second(seconds), args.output);
 }
 
 }  // namespace

@@ -9,7 +9,8 @@ Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector
                                const std::array<float, 3>& background, ViewImages* truth,
                                const eval::LoadedLpips& lpips, const std::filesystem::path& dir) {
   Evaluation evaluation;
-  evaluation.seconds_per_view = render_views_to(dir, model, cameras, background, 1.0);
+  evaluation.seconds_per_view =
+      render_views_recorded(dir, model, cameras, background, 1.0, {{"split", "test"}});
   if (!truth) return evaluation;
   eval::MetricsReport& report = evaluation.report;
   report.lpips_status = lpips.status;

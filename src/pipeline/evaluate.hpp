@@ -18,7 +18,8 @@ struct Evaluation {
   double seconds_per_view = 0;  // rendering alone
 };
 
-// Renders `cameras` into <dir>/{rgb,depth,alpha}; with `truth`, scores every render against
+// Renders the test views `cameras` into <dir>/{rgb,depth,alpha}, recorded in <dir>/render.json
+// (render_views_recorded) for eval; with `truth`, scores every render against
 // truth->rgb(camera), with LPIPS when `lpips` holds the metric, and writes <dir>/metrics.json
 // and .csv.
 Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector<Camera>& cameras,

@@ -7,6 +7,7 @@
 
 #include "core/memory.hpp"
 #include "core/stopwatch.hpp"
+#include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "io/image_tensor.hpp"
 #include "io/npy.hpp"
@@ -100,6 +101,31 @@ double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel
                  camera.intrinsics.height);
   }
   return cameras.empty() ? 0 : render_seconds / double(cameras.size());
+}
+
+double render_views_recorded(const std::filesystem::path& dir, const gs::GaussianModel& model,
+                             const std::vector<Camera>& cameras,
+                             const std::array<float, 3>& background, double scale,
+                             nlohmann::json record) {
+  std::vector<std::string> names;
+  for (const Camera& camera : cameras) names.push_back(camera.name);
+  const Camera first = cameras.empty() ? Camera{} : cameras.front().scaled(scale);
+  record["views"] = cameras.size();
+  record["width"] = first.intrinsics.width;
+  record["height"] = first.intrinsics.height;
+  record["gaussians"] = model.size();
+  record["rasterize_mode"] = model.antialiased ? "antialiased" : "classic";
+  record["background"] = background;
+  record["names"] = names;
+  record["finished"] = false;
+  const std::filesystem::path path = dir / "render.json";
+  write_file_atomically(path, record.dump(2) + "\n");
+  const double seconds = render_views_to(dir, model, cameras, background, scale);
+  record["seconds_per_view"] = seconds;
+  record["fps"] = frames_per_second(seconds);
+  record["finished"] = true;
+  write_file_atomically(path, record.dump(2) + "\n");
+  return seconds;
 }
 
 }  // namespace iesrgs::pipeline

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "gs/model.hpp"
 #include "io/camera.hpp"
 
@@ -46,6 +48,16 @@ void require_render_memory(const std::vector<Camera>& cameras, double scale);
 double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,
                        const std::vector<Camera>& cameras, const std::array<float, 3>& background,
                        double scale);
+
+// render_views_to, recorded in <dir>/render.json for eval and for a later render into the folder:
+// written first with "finished": false, `record`'s own fields (the split, or the camera path), the
+// views' count, size and names, the model's Gaussians and 2D filter, and the background; then
+// again with "finished": true, the seconds per view and the frame rate. A render stopped partway
+// is so known for one. Returns the seconds per view.
+double render_views_recorded(const std::filesystem::path& dir, const gs::GaussianModel& model,
+                             const std::vector<Camera>& cameras,
+                             const std::array<float, 3>& background, double scale,
+                             nlohmann::json record);
 
 // The frame rate of a mean time per view; 0 when nothing was timed.
 inline double frames_per_second(double seconds_per_view) {

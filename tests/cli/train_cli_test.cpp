@@ -157,6 +157,11 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   const auto splat = dir / "scene.splat";
   const CliRun exported = iesrgs("export " + out + " " + splat.string());
   ASSERT_EQ(exported.status, 0) << exported.output;
+  EXPECT_TRUE(contains(exported.output,
+                       "note: a .splat file has no place for the background the "
+                       "model was trained over; render it with --background "
+                       "1,1,1"))
+      << exported.output;
   const size_t gaussians = read_ply(dir / "run" / "point_cloud.ply").size();
   EXPECT_EQ(std::filesystem::file_size(splat), 32 * gaussians);
   const auto spz = dir / "scene.spz";
