@@ -1,6 +1,6 @@
 #include "cli/external_options.hpp"
 
-#include "cli/validators.hpp"
+#include "cli/shared_options.hpp"
 
 namespace iesrgs::cli {
 
@@ -8,9 +8,7 @@ void add_external_options(CLI::App& command, pipeline::ExternalOptions& o) {
   command.add_option("--sr-model", o.sr_model, "2D SR backend (see iesrgs upscale)")
       ->capture_default_str();
   command.add_option("--sr-weights", o.sr_weights, "SR checkpoint (default: the model's own)");
-  command.add_option("--tile", o.tiles.tile, "SR tile side in input pixels, 0 = whole image")
-      ->capture_default_str()
-      ->check(kNonNegative);
+  add_tile_options(command, o.tiles);
   command
       .add_option("--depth-model", o.depth_model,
                   "none, or depth-anything-v2[-vits|-vitb|-vitl] (needs --depth-weights)")

@@ -34,6 +34,19 @@ void add_gray_background_option(CLI::App& command, float& gray) {
       ->capture_default_str();
 }
 
+void add_tile_options(CLI::App& command, priors::sr::TileOptions& tiles) {
+  command
+      .add_option("--tile", tiles.tile,
+                  "SR tile side in input pixels, 0 for the whole image at once")
+      ->capture_default_str()
+      ->check(kNonNegative);
+  command
+      .add_option("--tile-overlap", tiles.overlap,
+                  "Input pixels shared by neighbouring SR tiles, cross-faded")
+      ->capture_default_str()
+      ->check(kNonNegative);
+}
+
 void use_device(const std::string& device) {
   set_compute_device(parse_device(device));
   fmt::print("device: {}\n", describe_device(compute_device()));

@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "priors/sr/tiling.hpp"
+
 namespace iesrgs::cli {
 
 // Adds --device cpu|cuda|auto (default auto) to `command`, stored in `device`: where the tensors
@@ -16,6 +18,9 @@ void add_lpips_option(CLI::App& command, std::string& backbone);
 // Adds --background, the gray level in [0, 1] that the networks' commands composite transparent
 // pixels over, stored in `gray`.
 void add_gray_background_option(CLI::App& command, float& gray);
+
+// Adds --tile and --tile-overlap, how the SR networks' commands cut an image, stored in `tiles`.
+void add_tile_options(CLI::App& command, priors::sr::TileOptions& tiles);
 
 // Makes `device` this process's compute device (core/device.hpp) and says which it is. Throws
 // Error when it names a GPU this build or machine cannot use.

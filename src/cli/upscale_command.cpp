@@ -137,16 +137,7 @@ void add_upscale_command(CLI::App& app) {
                    "setup installs; swinir needs one, bicubic takes none")
       ->check(CLI::ExistingPath);
   command->add_option("--scale", args->scale, "Upscaling factor")->capture_default_str();
-  command
-      ->add_option("--tile", args->tiles.tile,
-                   "Tile side in input pixels, 0 for the whole image at once")
-      ->capture_default_str()
-      ->check(kNonNegative);
-  command
-      ->add_option("--tile-overlap", args->tiles.overlap,
-                   "Input pixels shared by neighbouring tiles, cross-faded")
-      ->capture_default_str()
-      ->check(kNonNegative);
+  add_tile_options(*command, args->tiles);
   add_gray_background_option(*command, args->background);
   command->add_option("input", args->input, "Image or folder of images")->required();
   command->add_option("output", args->output, "PNG file, or folder for a folder input")

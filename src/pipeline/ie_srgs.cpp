@@ -46,6 +46,8 @@ std::string external_stage_command(const RunOptions& o, int lr_downscale) {
   if (!external.sr_weights.empty()) command += " --sr-weights " + external.sr_weights.string();
   if (external.tiles.tile != priors::sr::kDefaultTiles.tile)
     command += fmt::format(" --tile {}", external.tiles.tile);
+  if (external.tiles.overlap != priors::sr::kDefaultTiles.overlap)
+    command += fmt::format(" --tile-overlap {}", external.tiles.overlap);
   if (external.depth_model != "none") command += " --depth-model " + external.depth_model;
   if (!external.depth_weights.empty())
     command += " --depth-weights " + external.depth_weights.string();

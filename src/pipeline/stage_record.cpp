@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -32,17 +33,21 @@ nlohmann::json stage_json(const std::filesystem::path& dir) {
 }
 
 // Whether the record is of these parameters. When it is of others, says which at debug level
-// (iesrgs -v): why a stage is made again is otherwise a guess.
+// (iesrgs -v), once for a record however often it is checked: why a stage is made again is
+// otherwise a guess.
 bool params_match(const std::filesystem::path& dir, const nlohmann::json& record,
                   const nlohmann::json& params) {
   const nlohmann::json recorded = record.value("params", nlohmann::json());
   if (recorded == params) return true;
-  if (!recorded.is_null()) {
+  if (!recorded.is_null() && spdlog::should_log(spdlog::level::debug)) {
     std::vector<std::string> changed;
     for (const nlohmann::json& operation : nlohmann::json::diff(recorded, params))
       changed.push_back(operation.value("path", ""));
-    spdlog::debug("{}: recorded with other parameters ({})", (dir / "stage.json").string(),
-                  fmt::join(changed, ", "));
+    const std::string message =
+        fmt::format("{}: recorded with other parameters ({})", (dir / "stage.json").string(),
+                    fmt::join(changed, ", "));
+    static std::set<std::string> said;
+    if (said.insert(message).second) spdlog::debug(message);
   }
   return false;
 }

@@ -117,6 +117,12 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
     EXPECT_TRUE(agreement[key].get<double>() >= 0 && agreement[key].get<double>() <= 1) << key;
   for (const char* key : {"psnr_external", "psnr_internal", "psnr_fused", "psnr_oracle"})
     EXPECT_GT(agreement[key].get<double>(), 8.0) << key;
+  // Recorded as iesrgs render records its views, for eval to score them as the run did.
+  const auto record =
+      nlohmann::json::parse(read_file(dir / "run" / "rows/ie-srgs/test/render.json"));
+  EXPECT_EQ(record["split"], "test");
+  EXPECT_EQ(record["finished"], true);
+  EXPECT_EQ(record["background"], nlohmann::json::array({1, 1, 1}));
   const ImageHeader render = read_image_header(dir / "run" / "rows/ie-srgs/test/rgb/r_0.png");
   EXPECT_EQ(render.width, 48);
   EXPECT_EQ(read_image_header(dir / "run" / "internal/sr/rgb/r_0.png").width, 48);
@@ -158,10 +164,9 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   const CliRun other = iesrgs("-v fuse " + external_args + " --internal-set seed=7");
   ASSERT_EQ(other.status, 0) << other.output;
   // With -v, why the stage is made again.
-  EXPECT_TRUE(contains(other.output,
-                       "internal/stage.json: recorded with other parameters "
-                       "(/training/seed)"))
-      << other.output;
+  const std::string why = "internal/stage.json: recorded with other parameters (/training/seed)";
+  EXPECT_TRUE(contains(other.output, why)) << other.output;
+  EXPECT_EQ(other.output.find(why), other.output.rfind(why)) << other.output;  // said once
   const Table independent = {{"bicubic", true}, {"external", false}, {"hr", true}};
   EXPECT_EQ(table(), independent);
 
