@@ -58,17 +58,23 @@ class DatasetWriter {
     total_ = options.train_views + options.test_views;
   }
 
-  void write(const SplitViews& split) {
-    nlohmann::json frames = nlohmann::json::array();
-    for (size_t i = 0; i < split.poses.size(); ++i) {
-      const std::string stem = std::string(split.name) + "/r_" + std::to_string(i);
-      write_view(split.poses[i], stem);
-      frames.push_back({{"file_path", "./" + stem}, {"transform_matrix", split.poses[i].matrix()}});
+  // The views of every split, then their transforms files, the training split's last: a folder
+  // with transforms_train.json holds a whole scene, and a stopped run leaves none.
+  void write_blender(const std::vector<SplitViews>& splits) {
+    std::vector<nlohmann::json> transforms;
+    for (const SplitViews& split : splits) {
+      nlohmann::json frames = nlohmann::json::array();
+      for (size_t i = 0; i < split.poses.size(); ++i) {
+        const std::string stem = std::string(split.name) + "/r_" + std::to_string(i);
+        write_view(split.poses[i], stem);
+        frames.push_back(
+            {{"file_path", "./" + stem}, {"transform_matrix", split.poses[i].matrix()}});
+      }
+      transforms.push_back({{"camera_angle_x", settings_.camera_angle_x}, {"frames", frames}});
     }
-    const nlohmann::json transforms{{"camera_angle_x", settings_.camera_angle_x},
-                                    {"frames", frames}};
-    write_file_atomically(dir_ / (std::string("transforms_") + split.name + ".json"),
-                          transforms.dump(4) + "\n");
+    for (size_t k = splits.size(); k-- > 0;)
+      write_file_atomically(dir_ / (std::string("transforms_") + splits[k].name + ".json"),
+                            transforms[k].dump(4) + "\n");
   }
 
   // Opaque photos over black, as a camera would take them and as captures are trained; the model
@@ -107,6 +113,26 @@ class DatasetWriter {
   int done_ = 0, total_ = 0;
 };
 
+// The files that make a folder a scene, of an earlier scene written there: until this one is
+// whole, the folder is none, rather than the earlier one's cameras over some of this one's images.
+void remove_earlier_scene(const fs::path& dir) {
+  if (!fs::is_directory(dir)) return;
+  std::vector<fs::path> files = {dir / "transforms_train.json", dir / "transforms_test.json"};
+  for (const char* name : {"cameras", "images", "points3D"})
+    for (const char* extension : {".bin", ".txt"})
+      files.push_back(dir / "sparse" / "0" / (std::string(name) + extension));
+  for (const fs::path& file : files) {
+    std::error_code ec;
+    if (!fs::remove(file, ec) && ec)
+      fail_file(file, "left by an earlier scene, and cannot be removed: " + ec.message());
+  }
+  // sparse/ alone makes a COLMAP scene; kept when it holds anything else.
+  for (const fs::path& folder : {dir / "sparse" / "0", dir / "sparse"}) {
+    std::error_code ec;
+    fs::remove(folder, ec);
+  }
+}
+
 }  // namespace
 
 int default_samples(int size) {
@@ -119,12 +145,13 @@ void write_synth_dataset(const fs::path& dir, const SynthOptions& options,
                          const ViewProgress& progress) {
   check_options(options);
   DatasetWriter writer(dir, options, progress);
+  remove_earlier_scene(dir);
   if (options.format == SynthFormat::Colmap) {
     writer.write_colmap(train_orbit(options.train_views + options.test_views, options.seed));
     return;
   }
-  writer.write({"train", train_orbit(options.train_views, options.seed)});
-  writer.write({"test", test_orbit(options.test_views)});
+  writer.write_blender({{"train", train_orbit(options.train_views, options.seed)},
+                        {"test", test_orbit(options.test_views)}});
 }
 
 }  // namespace iesrgs::synth

@@ -148,6 +148,28 @@ TEST(SynthDataset, ReportsProgressPerView) {
   for (int i = 0; i < 5; ++i) EXPECT_EQ(calls[i], std::make_pair(i + 1, 5));
 }
 
+// Stopped partway (here by an error from the progress callback, as Ctrl-C stops the command), a
+// scene written over an earlier one leaves no scene: not the earlier cameras over new images.
+TEST(SynthDataset, AStoppedSceneIsNoScene) {
+  TempDir dir;
+  for (const SynthFormat format : {SynthFormat::Blender, SynthFormat::Colmap}) {
+    SynthOptions options = tiny();
+    options.format = format;
+    write_synth_dataset(dir.path(), options);
+    ASSERT_TRUE(is_scene(dir.path()));
+    options.seed = 8;
+    const std::string message = error_message([&] {
+      write_synth_dataset(dir.path(), options, [](int done, int) {
+        if (done == 4) fail("stopped");
+      });
+    });
+    EXPECT_EQ(message, "stopped");
+    EXPECT_FALSE(is_scene(dir.path()));
+    write_synth_dataset(dir.path(), options);  // and written again, whole
+    EXPECT_TRUE(is_scene(dir.path()));
+  }
+}
+
 TEST(SynthDataset, RejectsBadOptions) {
   TempDir dir;
   SynthOptions options = tiny();
