@@ -17,7 +17,6 @@
 #include "core/device.hpp"
 #include "core/error.hpp"
 #include "gs/model.hpp"
-#include "io/atomic_file.hpp"
 #include "io/folder_lock.hpp"
 #include "io/model_file.hpp"
 #include "pipeline/camera_path.hpp"
@@ -42,42 +41,6 @@ struct RenderArgs {
   std::string rasterize_mode = "auto";
   std::string device = "auto";
 };
-
-// Whether `name` stays inside the folder it is joined to (a COLMAP view's name may hold folders).
-bool inside_folder(const std::string& name) {
-  const std::filesystem::path path(name);
-  if (name.empty() || path.has_root_path()) return false;
-  return std::none_of(path.begin(), path.end(), [](const auto& part) { return part == ".."; });
-}
-
-void remove_earlier_file(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::remove(file, ec) && ec)
-    fail_file(file, "left by an earlier render, and cannot be removed: " + ec.message());
-}
-
-// What an earlier render into the folder leaves that would mix with this one, of the views
-// `names`: the views listed in its render.json that this one does not make (fewer path frames,
-// another split), and the report of eval's default location, which scored its views. Only those
-// files, and none outside the folder whatever render.json says.
-void remove_earlier_render(const std::filesystem::path& dir,
-                           const std::vector<std::string>& names) {
-  const std::filesystem::path report = dir / "render.json";
-  if (!std::filesystem::exists(report)) return;
-  for (const char* scores : {"metrics.json", "metrics.csv"}) remove_earlier_file(dir / scores);
-  const nlohmann::json earlier = nlohmann::json::parse(read_file(report), nullptr, false);
-  if (!earlier.is_object() || !earlier.contains("names") || !earlier["names"].is_array()) return;
-  for (const nlohmann::json& name : earlier["names"]) {
-    if (!name.is_string()) continue;
-    const std::string view = name.get<std::string>();
-    if (!inside_folder(view) || std::find(names.begin(), names.end(), view) != names.end())
-      continue;
-    const pipeline::RenderedViewFiles files = pipeline::rendered_view_files(dir, view);
-    for (const std::filesystem::path& file :
-         {files.rgb, files.depth_npy, files.depth_png, files.alpha})
-      remove_earlier_file(file);
-  }
-}
 
 // Checked before scaling, which rounds to int: a side beyond 2^16 is no render anyone can store.
 // Every view, since a scene's cameras may differ in size.
@@ -125,11 +88,7 @@ void run_render(const RenderArgs& args) {
   const char* mode = model.antialiased ? "antialiased" : "classic";
   fmt::print("rendering {} {} views of {} Gaussians at x{} ({}, background {})\n", cameras.size(),
              what, model.size(), args.scale, mode, fmt::join(scene.background, ","));
-  std::vector<std::string> names;
-  for (const Camera& camera : cameras) names.push_back(camera.name);
-  remove_earlier_render(args.output, names);
-  // What eval checks its ground truth against; a stopped render's views are the next one's to
-  // remove.
+  // What eval checks its ground truth against.
   const nlohmann::json record = args.path.empty() ? nlohmann::json{{"split", args.split}}
                                                   : nlohmann::json{{"path", args.path}};
   const double seconds = pipeline::render_views_recorded(args.output, model, cameras,

@@ -3,8 +3,10 @@
 #include <fmt/core.h>
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/error.hpp"
 #include "core/memory.hpp"
 #include "core/stopwatch.hpp"
 #include "io/atomic_file.hpp"
@@ -34,6 +36,42 @@ Image8 gray_image8(const torch::Tensor& plane) {
   Image8 image(int(plane.size(1)), int(plane.size(0)), 1);
   std::copy_n(bytes.data_ptr<uint8_t>(), image.data.size(), image.data.begin());
   return image;
+}
+
+// Whether `name` stays inside the folder it is joined to (a COLMAP view's name may hold folders).
+bool inside_folder(const std::string& name) {
+  const std::filesystem::path path(name);
+  if (name.empty() || path.has_root_path()) return false;
+  return std::none_of(path.begin(), path.end(), [](const auto& part) { return part == ".."; });
+}
+
+void remove_earlier_file(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::remove(file, ec) && ec)
+    fail_file(file, "left by an earlier render, and cannot be removed: " + ec.message());
+}
+
+// What an earlier render into the folder leaves that would mix with this one, of the views
+// `names`: the views listed in its render.json that this one does not make (fewer path frames,
+// another split), and the report of eval's default location, which scored its views. Only those
+// files, and none outside the folder whatever render.json says.
+void remove_earlier_render(const std::filesystem::path& dir,
+                           const std::vector<std::string>& names) {
+  const std::filesystem::path report = dir / "render.json";
+  if (!std::filesystem::exists(report)) return;
+  for (const char* scores : {"metrics.json", "metrics.csv"}) remove_earlier_file(dir / scores);
+  const nlohmann::json earlier = nlohmann::json::parse(read_file(report), nullptr, false);
+  if (!earlier.is_object() || !earlier.contains("names") || !earlier["names"].is_array()) return;
+  for (const nlohmann::json& name : earlier["names"]) {
+    if (!name.is_string()) continue;
+    const std::string view = name.get<std::string>();
+    if (!inside_folder(view) || std::find(names.begin(), names.end(), view) != names.end())
+      continue;
+    const RenderedViewFiles files = rendered_view_files(dir, view);
+    for (const std::filesystem::path& file :
+         {files.rgb, files.depth_npy, files.depth_png, files.alpha})
+      remove_earlier_file(file);
+  }
 }
 
 }  // namespace
@@ -109,6 +147,7 @@ double render_views_recorded(const std::filesystem::path& dir, const gs::Gaussia
                              nlohmann::json record) {
   std::vector<std::string> names;
   for (const Camera& camera : cameras) names.push_back(camera.name);
+  remove_earlier_render(dir, names);
   const Camera first = cameras.empty() ? Camera{} : cameras.front().scaled(scale);
   record["views"] = cameras.size();
   record["width"] = first.intrinsics.width;

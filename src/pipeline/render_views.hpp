@@ -49,11 +49,13 @@ double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel
                        const std::vector<Camera>& cameras, const std::array<float, 3>& background,
                        double scale);
 
-// render_views_to, recorded in <dir>/render.json for eval and for a later render into the folder:
-// written first with "finished": false, `record`'s own fields (the split, or the camera path), the
-// views' count, size and names, the model's Gaussians and 2D filter, and the background; then
-// again with "finished": true, the seconds per view and the frame rate. A render stopped partway
-// is so known for one. Returns the seconds per view.
+// render_views_to, recorded in <dir>/render.json for eval and for a later render into the folder.
+// First removes what an earlier recorded render there leaves that would mix with this one: its
+// views this one does not make, and eval's report of it. render.json is written first with
+// "finished": false, `record`'s own fields (the split, or the camera path), the views' count, size
+// and names, the model's Gaussians and 2D filter, and the background; then again with "finished":
+// true, the seconds per view and the frame rate. A render stopped partway is so known for one.
+// Returns the seconds per view.
 double render_views_recorded(const std::filesystem::path& dir, const gs::GaussianModel& model,
                              const std::vector<Camera>& cameras,
                              const std::array<float, 3>& background, double scale,

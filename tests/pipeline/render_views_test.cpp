@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "io/npy.hpp"
 #include "support/one_gaussian.hpp"
@@ -42,6 +43,31 @@ TEST(RenderViews, WritesEveryFileAtTheScaledSize) {
   ASSERT_EQ(depth.shape, (std::vector<size_t>{96, 128}));
   EXPECT_NEAR(depth.data[48 * 128 + 64], 4.0f, 0.05f);
   EXPECT_EQ(depth.data[0], 0.0f);
+}
+
+// A recorded render into a folder replaces the earlier one's: its views this one does not make go
+// (a run's test views after another --test-every, say), and its scores with them.
+TEST(RenderViews, ARecordedRenderReplacesTheEarlierOne) {
+  testing::TempDir dir;
+  const OneGaussian scene;
+  Camera other = scene.camera;
+  other.name = "w";
+  render_views_recorded(dir.path(), scene.model, {scene.camera, other}, {1, 1, 1}, 1.0,
+                        {{"split", "test"}});
+  write_file_atomically(dir / "metrics.json", "{}");
+  EXPECT_TRUE(std::filesystem::exists(rendered_view_files(dir.path(), "w").rgb));
+  render_views_recorded(dir.path(), scene.model, {scene.camera}, {0, 0, 0}, 1.0,
+                        {{"split", "test"}});
+  const RenderedViewFiles gone = rendered_view_files(dir.path(), "w");
+  for (const auto& file : {gone.rgb, gone.depth_npy, gone.depth_png, gone.alpha})
+    EXPECT_FALSE(std::filesystem::exists(file)) << file;
+  EXPECT_FALSE(std::filesystem::exists(dir / "metrics.json"));
+  EXPECT_TRUE(std::filesystem::exists(rendered_view_files(dir.path(), "v").rgb));
+  const auto record = nlohmann::json::parse(read_file(dir / "render.json"));
+  EXPECT_EQ(record["names"], nlohmann::json::array({"v"}));
+  EXPECT_EQ(record["background"], nlohmann::json::array({0, 0, 0}));
+  EXPECT_EQ(record["split"], "test");
+  EXPECT_EQ(record["finished"], true);
 }
 
 }  // namespace
