@@ -11,6 +11,7 @@
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "io/npy.hpp"
+#include "io/scene.hpp"
 #include "synth/camera_path.hpp"
 #include "synth/colmap_export.hpp"
 #include "synth/renderer.hpp"
@@ -113,14 +114,21 @@ class DatasetWriter {
   int done_ = 0, total_ = 0;
 };
 
-// The files that make a folder a scene, of an earlier scene written there: until this one is
-// whole, the folder is none, rather than the earlier one's cameras over some of this one's images.
-void remove_earlier_scene(const fs::path& dir) {
-  if (!fs::is_directory(dir)) return;
+// Marks a folder as synth's: its scene files are synth's to replace.
+constexpr char kMarker[] = "synth.json";
+
+// Refuses a folder holding a scene synth did not write (a capture's COLMAP model is not ours to
+// replace); in one it did, removes the files that make the folder a scene, so that until this
+// scene is whole the folder is none, rather than the earlier cameras over some new images.
+void replace_earlier_scene(const fs::path& dir, const SynthOptions& options) {
+  if (is_scene(dir) && !fs::exists(dir / kMarker))
+    fail_file(dir, fmt::format("holds a scene without {}, the mark of synth's own (a capture's "
+                               "files are not synth's to replace); write the synthetic scene "
+                               "into another folder",
+                               kMarker));
   std::vector<fs::path> files = {dir / "transforms_train.json", dir / "transforms_test.json"};
-  for (const char* name : {"cameras", "images", "points3D"})
-    for (const char* extension : {".bin", ".txt"})
-      files.push_back(dir / "sparse" / "0" / (std::string(name) + extension));
+  for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"})
+    files.push_back(dir / "sparse" / "0" / name);
   for (const fs::path& file : files) {
     std::error_code ec;
     if (!fs::remove(file, ec) && ec)
@@ -131,6 +139,14 @@ void remove_earlier_scene(const fs::path& dir) {
     std::error_code ec;
     fs::remove(folder, ec);
   }
+  const nlohmann::json marker = {
+      {"format", options.format == SynthFormat::Colmap ? "colmap" : "blender"},
+      {"size", options.size},
+      {"views", options.train_views},
+      {"test_views", options.test_views},
+      {"seed", options.seed},
+      {"samples", options.samples ? options.samples : default_samples(options.size)}};
+  write_file_atomically(dir / kMarker, marker.dump(2) + "\n");
 }
 
 }  // namespace
@@ -145,7 +161,7 @@ void write_synth_dataset(const fs::path& dir, const SynthOptions& options,
                          const ViewProgress& progress) {
   check_options(options);
   DatasetWriter writer(dir, options, progress);
-  remove_earlier_scene(dir);
+  replace_earlier_scene(dir, options);
   if (options.format == SynthFormat::Colmap) {
     writer.write_colmap(train_orbit(options.train_views + options.test_views, options.seed));
     return;

@@ -170,6 +170,26 @@ TEST(SynthDataset, AStoppedSceneIsNoScene) {
   }
 }
 
+// A capture's COLMAP model or a dataset's transforms are not synth's to replace.
+TEST(SynthDataset, AFolderHoldingAnotherSceneIsRefusedUntouched) {
+  TempDir dir;
+  SynthOptions options = tiny();
+  options.format = SynthFormat::Colmap;
+  write_synth_dataset(dir.path(), options);
+  EXPECT_EQ(read_json(dir / "synth.json")["format"], "colmap");
+  std::filesystem::remove(dir / "synth.json");  // now a capture of someone else's
+  const std::string model = read_file(dir / "sparse" / "0" / "images.bin");
+  for (const SynthFormat format : {SynthFormat::Blender, SynthFormat::Colmap}) {
+    options.format = format;
+    EXPECT_EQ(error_message([&] { write_synth_dataset(dir.path(), options); }),
+              dir.path().string() +
+                  ": holds a scene without synth.json, the mark of synth's own (a capture's files "
+                  "are not synth's to replace); write the synthetic scene into another folder");
+  }
+  EXPECT_EQ(read_file(dir / "sparse" / "0" / "images.bin"), model);
+  EXPECT_FALSE(std::filesystem::exists(dir / "synth.json"));
+}
+
 TEST(SynthDataset, RejectsBadOptions) {
   TempDir dir;
   SynthOptions options = tiny();
