@@ -20,7 +20,10 @@ void add_synth_command(CLI::App& app) {
       "NeRF-Synthetic layout (RGBA PNGs, transforms_train/test.json) or a COLMAP capture");
   auto output = std::make_shared<std::string>();
   auto options = std::make_shared<synth::SynthOptions>();
-  command->add_option("-o,--output", *output, "Directory to write the scene into")
+  command
+      ->add_option("-o,--output", *output,
+                   "Directory to write the scene into; one holding a scene synth did not write "
+                   "is refused")
       ->required()
       ->check(kNonEmptyPath);
   command->add_option("--size", options->size, "Image width and height in pixels")

@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/file_digest.hpp"
 #include "io/image.hpp"
 #include "io/npy.hpp"
 #include "io/scene.hpp"
@@ -114,39 +115,64 @@ class DatasetWriter {
   int done_ = 0, total_ = 0;
 };
 
-// Marks a folder as synth's: its scene files are synth's to replace.
-constexpr char kMarker[] = "synth.json";
+// Records the options of the scene in a folder and the digests of the files that make the folder
+// a scene, as synth wrote them: those, unchanged, are synth's to replace.
+constexpr char kRecord[] = "synth.json";
 
-// Refuses a folder holding a scene synth did not write (a capture's COLMAP model is not ours to
-// replace); in one it did, removes the files that make the folder a scene, so that until this
-// scene is whole the folder is none, rather than the earlier cameras over some new images.
-void replace_earlier_scene(const fs::path& dir, const SynthOptions& options) {
-  if (is_scene(dir) && !fs::exists(dir / kMarker))
-    fail_file(dir, fmt::format("holds a scene without {}, the mark of synth's own (a capture's "
-                               "files are not synth's to replace); write the synthetic scene "
-                               "into another folder",
-                               kMarker));
-  std::vector<fs::path> files = {dir / "transforms_train.json", dir / "transforms_test.json"};
-  for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"})
-    files.push_back(dir / "sparse" / "0" / name);
-  for (const fs::path& file : files) {
-    std::error_code ec;
+// The files that make a folder a scene, in any format and COLMAP encoding, relative to it; synth
+// writes some of them, never nerfstudio's transforms.json.
+std::vector<std::string> index_files() {
+  std::vector<std::string> files = {"transforms_train.json", "transforms_test.json",
+                                    "transforms.json"};
+  for (const char* folder : {"sparse/0/", "sparse/"})
+    for (const char* name : {"cameras", "images", "points3D"})
+      for (const char* extension : {".bin", ".txt"})
+        files.push_back(std::string(folder) + name + extension);
+  return files;
+}
+
+// Refuses a folder holding a scene synth did not write, or has since changed (a capture's COLMAP
+// model is not synth's to replace); in one it did, removes those files, so that until this scene
+// is whole the folder is none, rather than the earlier cameras over some new images.
+void replace_earlier_scene(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec) || !is_scene(dir)) return;
+  const nlohmann::json record =
+      fs::exists(dir / kRecord, ec)
+          ? nlohmann::json::parse(read_file(dir / kRecord), nullptr, false)
+          : nlohmann::json();
+  const nlohmann::json written =
+      record.is_object() ? record.value("files", nlohmann::json()) : nlohmann::json();
+  std::vector<fs::path> present;
+  for (const std::string& name : index_files()) {
+    if (!fs::exists(dir / name, ec)) continue;
+    if (!written.is_object() || written.value(name, std::string()) != file_digest(dir / name))
+      fail_file(dir, fmt::format("holds a scene synth did not write ({} is not as {} records it); "
+                                 "write the synthetic scene into another folder",
+                                 name, kRecord));
+    present.push_back(dir / name);
+  }
+  for (const fs::path& file : present)
     if (!fs::remove(file, ec) && ec)
       fail_file(file, "left by an earlier scene, and cannot be removed: " + ec.message());
-  }
   // sparse/ alone makes a COLMAP scene; kept when it holds anything else.
-  for (const fs::path& folder : {dir / "sparse" / "0", dir / "sparse"}) {
-    std::error_code ec;
-    fs::remove(folder, ec);
-  }
-  const nlohmann::json marker = {
+  for (const fs::path& folder : {dir / "sparse" / "0", dir / "sparse"}) fs::remove(folder, ec);
+}
+
+// Written once the scene is whole: its options, and the digests replace_earlier_scene checks.
+void record_scene(const fs::path& dir, const SynthOptions& options) {
+  nlohmann::json files = nlohmann::json::object();
+  for (const std::string& name : index_files())
+    if (fs::exists(dir / name)) files[name] = file_digest(dir / name);
+  const nlohmann::json record = {
       {"format", options.format == SynthFormat::Colmap ? "colmap" : "blender"},
       {"size", options.size},
       {"views", options.train_views},
       {"test_views", options.test_views},
       {"seed", options.seed},
-      {"samples", options.samples ? options.samples : default_samples(options.size)}};
-  write_file_atomically(dir / kMarker, marker.dump(2) + "\n");
+      {"samples", options.samples ? options.samples : default_samples(options.size)},
+      {"files", files}};
+  write_file_atomically(dir / kRecord, record.dump(2) + "\n");
 }
 
 }  // namespace
@@ -161,13 +187,13 @@ void write_synth_dataset(const fs::path& dir, const SynthOptions& options,
                          const ViewProgress& progress) {
   check_options(options);
   DatasetWriter writer(dir, options, progress);
-  replace_earlier_scene(dir, options);
-  if (options.format == SynthFormat::Colmap) {
+  replace_earlier_scene(dir);
+  if (options.format == SynthFormat::Colmap)
     writer.write_colmap(train_orbit(options.train_views + options.test_views, options.seed));
-    return;
-  }
-  writer.write_blender({{"train", train_orbit(options.train_views, options.seed)},
-                        {"test", test_orbit(options.test_views)}});
+  else
+    writer.write_blender({{"train", train_orbit(options.train_views, options.seed)},
+                          {"test", test_orbit(options.test_views)}});
+  record_scene(dir, options);
 }
 
 }  // namespace iesrgs::synth

@@ -30,11 +30,11 @@ int default_samples(int size);
 // Called after each written view with the number written so far and the total.
 using ViewProgress = std::function<void(int done, int total)>;
 
-// Throws Error for options out of range, for files that cannot be written, and for a folder that
-// holds a scene synth did not write. synth.json, written first, records the options and marks the
-// folder as synth's. An earlier synthetic scene's transforms files or COLMAP model are removed
-// before the views are written and this scene's written after them, so a folder that loads as a
-// scene holds a whole one.
+// Throws Error for options out of range, for files that cannot be written, and for a folder
+// holding a scene synth did not write. An earlier synthetic scene's transforms files or COLMAP
+// model are removed before the views are written, and this scene's written after them, so a
+// folder that loads as a scene holds a whole one. synth.json, written last, records the options
+// and the digests of those files, by which the next synth knows them for its own.
 void write_synth_dataset(const std::filesystem::path& dir, const SynthOptions& options,
                          const ViewProgress& progress = {});
 

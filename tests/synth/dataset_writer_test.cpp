@@ -170,24 +170,40 @@ TEST(SynthDataset, AStoppedSceneIsNoScene) {
   }
 }
 
-// A capture's COLMAP model or a dataset's transforms are not synth's to replace.
+// A capture's COLMAP model or a dataset's transforms are not synth's to replace, nor synth's own
+// once changed: only the files synth.json records, as it records them.
 TEST(SynthDataset, AFolderHoldingAnotherSceneIsRefusedUntouched) {
   TempDir dir;
   SynthOptions options = tiny();
   options.format = SynthFormat::Colmap;
   write_synth_dataset(dir.path(), options);
   EXPECT_EQ(read_json(dir / "synth.json")["format"], "colmap");
-  std::filesystem::remove(dir / "synth.json");  // now a capture of someone else's
   const std::string model = read_file(dir / "sparse" / "0" / "images.bin");
+  const auto refusal = [&](const std::string& file) {
+    return dir.path().string() + ": holds a scene synth did not write (" + file +
+           " is not as synth.json records it); write the synthetic scene into another folder";
+  };
+  // A text model beside synth's binary one, which a reader would take were the binary removed.
+  testing::write_text(dir / "sparse" / "0" / "cameras.txt", "# by hand\n");
+  EXPECT_EQ(error_message([&] { write_synth_dataset(dir.path(), options); }),
+            refusal("sparse/0/cameras.txt"));
+  std::filesystem::remove(dir / "sparse" / "0" / "cameras.txt");
+  std::filesystem::remove(dir / "synth.json");  // now a capture of someone else's
   for (const SynthFormat format : {SynthFormat::Blender, SynthFormat::Colmap}) {
     options.format = format;
     EXPECT_EQ(error_message([&] { write_synth_dataset(dir.path(), options); }),
-              dir.path().string() +
-                  ": holds a scene without synth.json, the mark of synth's own (a capture's files "
-                  "are not synth's to replace); write the synthetic scene into another folder");
+              refusal("sparse/0/cameras.bin"));
   }
   EXPECT_EQ(read_file(dir / "sparse" / "0" / "images.bin"), model);
-  EXPECT_FALSE(std::filesystem::exists(dir / "synth.json"));
+
+  // A nerfstudio capture, whose transforms.json synth's own files would shadow.
+  TempDir nerfstudio;
+  testing::write_text(nerfstudio / "transforms.json", R"({"frames": []})");
+  EXPECT_EQ(error_message([&] { write_synth_dataset(nerfstudio.path(), tiny()); }),
+            nerfstudio.path().string() +
+                ": holds a scene synth did not write (transforms.json is not as synth.json "
+                "records it); write the synthetic scene into another folder");
+  EXPECT_FALSE(std::filesystem::exists(nerfstudio / "transforms_train.json"));
 }
 
 TEST(SynthDataset, RejectsBadOptions) {
