@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -41,6 +42,19 @@ inline const std::vector<const char*> kImageExtensionSpellings = {".png", ".jpg"
 inline bool is_image_file(const std::filesystem::path& path) {
   const std::string extension = lowercase_extension(path);
   return extension == ".png" || extension == ".jpg" || extension == ".jpeg";
+}
+
+// `path` as one word of a POSIX shell command: as it is when it needs no quoting, else in single
+// quotes (a quote inside as '\''), so that a command printed for the user runs as printed.
+inline std::string shell_word(const std::filesystem::path& path) {
+  const std::string text = path.string();
+  const bool plain = !text.empty() && std::all_of(text.begin(), text.end(), [](unsigned char c) {
+    return std::isalnum(c) || (c != '\0' && std::strchr("/._-+,:=@%", c) != nullptr);
+  });
+  if (plain) return text;
+  std::string quoted = "'";
+  for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
 }
 
 }  // namespace iesrgs

@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/math.hpp"
+#include "core/paths.hpp"
 #include "core/progress.hpp"
 #include "core/stopwatch.hpp"
 #include "eval/lpips.hpp"
@@ -42,21 +43,21 @@ using loss::TextureGuidance;
 std::string external_stage_command(const RunOptions& o, int lr_downscale) {
   const ExternalOptions& external = o.external;
   std::string command = fmt::format("iesrgs external {} --downscale {} --scale {} --sr-model {}",
-                                    o.scene.string(), lr_downscale, o.scale, external.sr_model);
-  if (!external.sr_weights.empty()) command += " --sr-weights " + external.sr_weights.string();
+                                    shell_word(o.scene), lr_downscale, o.scale, external.sr_model);
+  if (!external.sr_weights.empty()) command += " --sr-weights " + shell_word(external.sr_weights);
   if (external.tiles.tile != priors::sr::kDefaultTiles.tile)
     command += fmt::format(" --tile {}", external.tiles.tile);
   if (external.tiles.overlap != priors::sr::kDefaultTiles.overlap)
     command += fmt::format(" --tile-overlap {}", external.tiles.overlap);
   if (external.depth_model != "none") command += " --depth-model " + external.depth_model;
   if (!external.depth_weights.empty())
-    command += " --depth-weights " + external.depth_weights.string();
+    command += " --depth-weights " + shell_word(external.depth_weights);
   if (const auto& background = o.scene_options.background)
     command +=
         fmt::format(" --background {},{},{}", (*background)[0], (*background)[1], (*background)[2]);
   if (o.scene_options.test_every != SceneOptions{}.test_every)
     command += fmt::format(" --test-every {}", o.scene_options.test_every);
-  return command + " -o " + (o.output / "external").string();
+  return command + " -o " + shell_word(o.output / "external");
 }
 
 // The HR rows take nearly all of a run's time: after each, where the run stands, with an ETA for

@@ -147,6 +147,7 @@ double render_views_recorded(const std::filesystem::path& dir, const gs::Gaussia
                              nlohmann::json record) {
   std::vector<std::string> names;
   for (const Camera& camera : cameras) names.push_back(camera.name);
+  require_render_memory(cameras, scale);  // before anything of the earlier render goes
   remove_earlier_render(dir, names);
   const Camera first = cameras.empty() ? Camera{} : cameras.front().scaled(scale);
   record["views"] = cameras.size();

@@ -16,5 +16,13 @@ TEST(Paths, ExtensionsCompareInAnyCase) {
   EXPECT_FALSE(is_image_file("notes.txt"));
 }
 
+TEST(Paths, ShellWordsQuoteOnlyWhatAShellWouldSplitOrExpand) {
+  EXPECT_EQ(shell_word("/data/lego-x4/run_1.5,b=c"), "/data/lego-x4/run_1.5,b=c");
+  EXPECT_EQ(shell_word("my scenes/lego"), "'my scenes/lego'");
+  EXPECT_EQ(shell_word("$HOME/*"), "'$HOME/*'");
+  EXPECT_EQ(shell_word("it's"), "'it'\\''s'");
+  EXPECT_EQ(shell_word(""), "''");
+}
+
 }  // namespace
 }  // namespace iesrgs
