@@ -9,7 +9,14 @@ out=demo  # in the repository; a folder given is taken from where the script is 
 [ -z "${1:-}" ] || out=$(realpath -m -- "$1")
 cd "$(dirname "$0")/.."
 scripts/setup.sh --cli
-build/iesrgs synth -o "$out/scene" --size 128 --views 40 --test-views 10 --seed 1
+# A scene already there is reused, as the run reuses its stages: synth writes transforms_train.json
+# last, so the file means a whole scene, and synth refuses a folder made by a version before
+# synth.json.
+if [ -f "$out/scene/transforms_train.json" ]; then
+  echo "reusing the synthetic scene in $out/scene"
+else
+  build/iesrgs synth -o "$out/scene" --size 128 --views 40 --test-views 10 --seed 1
+fi
 # A short CPU schedule, and fewer random starting points than 3DGS's 100k for a scene this small.
 build/iesrgs run "$out/scene" -o "$out/run" --scale 4 --rows demo --lpips none \
   --iterations 1500 --set random_points=20000 \
