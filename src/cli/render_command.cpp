@@ -81,8 +81,6 @@ void run_render(const RenderArgs& args) {
   }
   if (cameras.empty()) fail_file(scene.root, fmt::format("has no {} views", args.split));
   require_render_sizes(cameras, args.scale, scene.root);
-  // Before anything of an earlier render is removed.
-  pipeline::require_render_memory(cameras, args.scale);
   // Two renders into one folder would leave a mix of two models' views.
   const FolderLock lock(args.output);
   const char* mode = model.antialiased ? "antialiased" : "classic";

@@ -34,10 +34,9 @@ struct SplatCloud {
 
 // binary_little_endian float32 in 3DGS's property order: x y z nx ny nz f_dc_0..2 f_rest_*
 // opacity scale_0..2 rot_0..3, then Mip-Splatting's filter_3D when present; the background as a
-// comment when set. Normals are written as
-// zeros and f_rest channel-major (all R coefficients, then G, then B), as 3DGS flattens its
-// transposed tensor. Written atomically; throws Error naming the file when the arrays disagree in
-// size or hold a non-finite value.
+// comment when set. Normals are written as zeros and f_rest channel-major (all R coefficients,
+// then G, then B), as 3DGS flattens its transposed tensor. Written atomically; throws Error naming
+// the file when the arrays disagree in size or hold a non-finite value.
 void write_ply(const std::filesystem::path& path, const SplatCloud& cloud);
 
 // Throws Error naming `path` when the cloud's arrays disagree with its size and SH degree.
