@@ -26,7 +26,6 @@ namespace {
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
               "binary PLY values are copied as they are, which needs a little-endian host");
 
-constexpr int kMaxShDegree = 3;
 constexpr std::string_view kRestPrefix = "f_rest_";
 constexpr char kFilterName[] = "filter_3D";
 constexpr std::string_view kBackgroundComment = "background";
@@ -72,8 +71,9 @@ std::vector<Slot> layout(int sh_degree, bool with_filter_3d) {
 
 // The cloud's layout, after checking that its arrays match it.
 std::vector<Slot> checked_layout(const SplatCloud& cloud, const fs::path& path) {
-  if (cloud.sh_degree < 0 || cloud.sh_degree > kMaxShDegree)
-    fail_file(path, fmt::format("SH degree {} is outside 0..{}", cloud.sh_degree, kMaxShDegree));
+  if (cloud.sh_degree < 0 || cloud.sh_degree > kMaxCloudShDegree)
+    fail_file(path,
+              fmt::format("SH degree {} is outside 0..{}", cloud.sh_degree, kMaxCloudShDegree));
   std::vector<Slot> slots = layout(cloud.sh_degree, cloud.has_filter_3d());
   const size_t count = cloud.size();
   for (const Slot& slot : slots) {
@@ -337,7 +337,7 @@ bool is_rest_coefficient(const Property& property) {
 int infer_sh_degree(const Header& header, const fs::path& name) {
   const size_t rest =
       std::count_if(header.properties.begin(), header.properties.end(), is_rest_coefficient);
-  for (int degree = 0; degree <= kMaxShDegree; ++degree)
+  for (int degree = 0; degree <= kMaxCloudShDegree; ++degree)
     if (rest == 3 * rest_per_channel(degree)) return degree;
   fail_file(name,
             fmt::format("{} f_rest properties; expected 0, 9, 24 or 45 (SH degree 0 to 3)", rest));

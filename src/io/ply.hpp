@@ -10,6 +10,9 @@
 
 namespace iesrgs {
 
+// The highest SH degree a cloud holds: 3DGS's, and the renderer's.
+constexpr int kMaxCloudShDegree = 3;
+
 // Gaussians in 3DGS's raw (pre-activation) storage form, structure of arrays, N Gaussians.
 struct SplatCloud {
   int sh_degree = 0;              // 0..3; K = (sh_degree + 1)^2 coefficients per channel

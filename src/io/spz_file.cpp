@@ -26,6 +26,7 @@ constexpr uint32_t kOldestReadVersion = 2;  // version 1 (float16 positions) was
 constexpr uint32_t kFirstSmallestThreeVersion = 3;  // 4-byte rotations; 3 bytes (x y z) before
 constexpr uint32_t kFirstZstdVersion = 4;           // a stream per attribute, each zstd-compressed
 constexpr uint32_t kNewestReadVersion = 4;
+constexpr int kSpzMaxShDegree = 4;  // the format's; bands above the cloud's are dropped
 constexpr uint8_t kAntialiased = 1;
 constexpr uint8_t kHasExtensions = 2;
 // No attribute stream compresses better than this; a larger claim is a corrupt file.
@@ -172,7 +173,8 @@ SpzHeader read_spz_header(ByteReader& in, uint32_t version) {
   h.sh_degree = in.little<uint8_t>();
   h.bits = in.little<uint8_t>();
   h.flags = in.little<uint8_t>();
-  if (h.sh_degree > 3) throw FormatError(fmt::format("SH degree {} is above 3", h.sh_degree));
+  if (h.sh_degree > kSpzMaxShDegree)
+    throw FormatError(fmt::format("SH degree {} is above {}", h.sh_degree, kSpzMaxShDegree));
   if (h.bits > 23) throw FormatError(fmt::format("{} fractional bits exceed 23", h.bits));
   if (h.flags & kHasExtensions)
     spdlog::warn(".spz extensions are not read; the Gaussians are decoded without them");
@@ -319,6 +321,20 @@ SplatCloud decode_streams(const SpzHeader& h, const std::string& streams) {
   return cloud;
 }
 
+// The renderer draws SH up to degree 3: a degree-4 cloud keeps its first 15 coefficients per
+// channel, the bands every 3DGS tool draws, and loses the fourth band's view-dependent detail.
+void drop_fourth_band(SplatCloud& cloud, const std::filesystem::path& name) {
+  if (cloud.sh_degree <= kMaxCloudShDegree) return;
+  spdlog::warn("{}: SH degree {} read up to degree {}; the higher band is dropped", name.string(),
+               cloud.sh_degree, kMaxCloudShDegree);
+  const size_t from = 3 * (size_t(cloud.sh_degree + 1) * (cloud.sh_degree + 1) - 1);
+  const size_t to = 3 * (size_t(kMaxCloudShDegree + 1) * (kMaxCloudShDegree + 1) - 1);
+  for (size_t i = 0; i < cloud.size(); ++i)
+    std::copy_n(cloud.sh_rest.begin() + i * from, to, cloud.sh_rest.begin() + i * to);
+  cloud.sh_rest.resize(cloud.size() * to);
+  cloud.sh_degree = kMaxCloudShDegree;
+}
+
 }  // namespace
 
 size_t write_spz(const std::filesystem::path& path, const SplatCloud& cloud) {
@@ -337,7 +353,9 @@ SplatCloud parse_spz(std::string_view bytes, const std::filesystem::path& name) 
       throw FormatError("not an .spz file (neither gzip nor an NGSP header)");
     const std::string streams =
         gzipped ? legacy_streams(bytes, header) : zstd_streams(bytes, header);
-    return decode_streams(header, streams);
+    SplatCloud cloud = decode_streams(header, streams);
+    drop_fourth_band(cloud, name);
+    return cloud;
   } catch (const FormatError& e) {
     fail_file(name, e.what());
   } catch (const std::bad_alloc&) {  // sizes up to 1024x the file's pass the checks above

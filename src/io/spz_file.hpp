@@ -22,8 +22,8 @@ size_t write_spz(const std::filesystem::path& path, const SplatCloud& cloud);
 // Reads versions 2 and 3 (gzip) and 4 (one zstd stream per attribute) into raw 3DGS parameters:
 // logit opacities (bytes 0 and 255 half a quantization step inside (0, 1), where they would be
 // infinite), colours back to f_dc, unit quaternions. A written 3D filter stays baked in, so the
-// cloud has no filter_3d; the "antialiased" flag sets the cloud's. Throws Error naming the file
-// for anything it cannot decode.
+// cloud has no filter_3d; the "antialiased" flag sets the cloud's. A degree-4 file keeps SH bands
+// 0 to 3, with a warning. Throws Error naming the file for anything it cannot decode.
 SplatCloud read_spz(const std::filesystem::path& path);
 
 // read_spz on bytes already in memory; `name` is only used in error messages.

@@ -210,12 +210,12 @@ TEST(SpzRead, SaturatedOpacitiesStayFinite) {
 }
 
 // A one-Gaussian gzip .spz of the given version whose rotation is `rotation` (3 bytes for
-// version 2, 4 after), everything else zero.
+// version 2, 4 after) and whose higher SH bands are `sh`, of `degree`; everything else zero.
 void write_legacy_spz(const std::filesystem::path& path, uint8_t version,
-                      const std::string& rotation) {
+                      const std::string& rotation, uint8_t degree = 0, const std::string& sh = "") {
   std::string bytes("NGSP", 4);
-  bytes += std::string{char(version), 0, 0, 0, 1, 0, 0, 0, 0, 12, 0, 0};  // count 1, degree 0
-  bytes += std::string(9 + 1 + 3 + 3, '\0') + rotation;
+  bytes += std::string{char(version), 0, 0, 0, 1, 0, 0, 0, char(degree), 12, 0, 0};  // count 1
+  bytes += std::string(9 + 1 + 3 + 3, '\0') + rotation + sh;
   gzFile file = gzopen(path.c_str(), "wb");
   ASSERT_NE(file, nullptr);
   ASSERT_EQ(gzwrite(file, bytes.data(), unsigned(bytes.size())), int(bytes.size()));
@@ -237,6 +237,22 @@ TEST(SpzRead, OverlongRotationsComeBackNormalized) {
     EXPECT_EQ(cloud.rotations[0], 0.0f);  // the completed component: nothing left for it
     EXPECT_NEAR(cloud.rotations[1], 1 / std::sqrt(3.0), 1e-6);
   }
+}
+
+// Niantic's library writes SH up to degree 4; the renderer draws up to 3, so the fourth band goes.
+TEST(SpzRead, DegreeFourKeepsTheFirstThreeBands) {
+  TempDir dir;
+  std::string sh;
+  for (int k = 0; k < 3 * 24; ++k) sh += char(k);  // 24 coefficients per channel
+  write_legacy_spz(dir / "a.spz", 3, std::string(4, '\0'), 4, sh);
+  const SplatCloud cloud = read_spz(dir / "a.spz");
+  EXPECT_EQ(cloud.sh_degree, 3);
+  ASSERT_EQ(cloud.sh_rest.size(), 45u);
+  for (int k = 0; k < 45; ++k) EXPECT_FLOAT_EQ(cloud.sh_rest[k], (k - 128) / 128.0f) << k;
+  sh += std::string(3 * 11, '\0');  // degree 5's extra coefficients: no format allows it
+  write_legacy_spz(dir / "b.spz", 3, std::string(4, '\0'), 5, sh);
+  const std::string message = error_message([&] { read_spz(dir / "b.spz"); });
+  EXPECT_TRUE(contains(message, "b.spz: SH degree 5 is above 4")) << message;
 }
 
 TEST(SpzRead, MalformedFilesNameTheFileAndTheProblem) {
