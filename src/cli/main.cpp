@@ -12,6 +12,8 @@
 #include "core/torch_error.hpp"
 
 int main(int argc, char** argv) {
+  // Progress reaches a pipe or a log as each line is printed, and a killed command keeps it.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   CLI::App app{"iesrgs: super-resolution 3D Gaussian Splatting (IE-SRGS) on CPUs and GPUs"};
   // LibTorch's CPU ops (the networks) default to one thread here; give them the cores OpenMP
   // uses for our own kernels (OMP_NUM_THREADS still limits both).
