@@ -88,7 +88,7 @@ void print_model_summary(const std::filesystem::path& path) {
 }
 
 // A run folder of iesrgs run: its results table (once the run has finished) and each trained
-// row's model.
+// row's model, the internal row's being the internal model.
 void print_run_summary(const std::filesystem::path& run) {
   const std::filesystem::path table = run / "results.md";
   if (std::filesystem::exists(table))
@@ -99,6 +99,8 @@ void print_run_summary(const std::filesystem::path& run) {
   for (const auto& row : std::filesystem::directory_iterator(run / "rows"))
     if (std::filesystem::exists(train::model_path(row.path())))
       models.push_back(train::model_path(row.path()));
+  if (std::filesystem::exists(train::model_path(run / "internal")))
+    models.push_back(train::model_path(run / "internal"));
   std::sort(models.begin(), models.end());
   for (const std::filesystem::path& model : models)
     fmt::print("model of {:<16} {}\n", model.parent_path().filename().string(), model.string());

@@ -102,6 +102,7 @@ class Pipeline {
   bool row_uses_internal(const RowSpec& row) const;
   bool rows_use_internal_references() const;
   void check_cached_inputs() const;
+  void forget_earlier_results() const;
   void run_external_stages();
   void run_internal_stage();
   std::vector<Camera> hr_train_cameras() const;
@@ -120,6 +121,7 @@ class Pipeline {
   void keep_earlier_rows(RunResult& result) const;
   void write_fusion_diagnostics(const gs::GaussianModel& model, const FusionSetup& setup) const;
   void write_mask_agreement(const FusionSetup& setup) const;
+  void say_truth_size_differs(size_t i, const Camera& camera) const;
   // The HR ground truth of training view i, (3, H, W); undefined when the run has none at
   // `camera`'s size.
   torch::Tensor train_truth(size_t i, const Camera& camera) const;
@@ -238,6 +240,18 @@ void Pipeline::check_cached_inputs() const {
     require(internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
                                    o_.output / "internal"),
             o_.output / "internal", "internal", "iesrgs internal or iesrgs run");
+}
+
+// An interrupted run leaves no table or test renders of an earlier one that read as its own: the
+// table is written again when the run finishes, each row's test views when the row is scored.
+// results.json stays, for keep_earlier_rows.
+void Pipeline::forget_earlier_results() const {
+  for (const char* table : {"results.md", "results.csv"}) {
+    std::error_code ec;
+    fs::remove(o_.output / table, ec);
+    if (ec) fail_file(o_.output / table, "cannot be removed before a new run: " + ec.message());
+  }
+  for (const std::string& id : rows_) mark_render_stale(o_.output / "rows" / id / "test");
 }
 
 void Pipeline::run_external_stages() {
@@ -442,6 +456,17 @@ torch::Tensor Pipeline::train_truth(size_t i, const Camera& camera) const {
   return to_tensor(*hr_images_->rgb(truth_camera))[0];
 }
 
+// The truth is there but not at the HR camera's size (an LR size that --scale does not divide the
+// truth's by): the diagnostics that compare with it are left out, and the user is told why.
+void Pipeline::say_truth_size_differs(size_t i, const Camera& camera) const {
+  const Intrinsics& truth = hr_scene_->split(Split::Train)[i]->intrinsics;
+  fmt::print(
+      "diagnostics: view {}'s HR truth is {}x{}, the HR training view {}x{} (its LR size x "
+      "{}); mask_check, truth and mask_agreement.json are left out\n",
+      camera.name, truth.width, truth.height, camera.intrinsics.width, camera.intrinsics.height,
+      o_.scale);
+}
+
 void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
   const fs::path path = o_.output / "diagnostics" / "mask_agreement.json";
   // Without both references and the truth there is nothing to check, and an earlier run's
@@ -453,7 +478,10 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
     const loss::FusionTargets& targets = setup.targets[i];
     if (!targets.internal_image.defined()) return;
     const torch::Tensor truth = train_truth(i, setup.cameras[i]);
-    if (!truth.defined()) return;
+    if (!truth.defined()) {
+      if (hr_scene_) say_truth_size_differs(i, setup.cameras[i]);
+      return;
+    }
     counts += eval::mask_counts(targets.internal_image, targets.external_image, truth, threshold_);
   }
   const nlohmann::json json = {{"threshold", threshold_},
@@ -485,6 +513,7 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
 RunResult Pipeline::run() {
   const Stopwatch watch;
   if (o_.only == StageSelection::Fusion) check_cached_inputs();
+  if (o_.only != StageSelection::Internal) forget_earlier_results();
   if (o_.only != StageSelection::Internal) run_external_stages();
   if (rows_use_internal_references() || o_.only == StageSelection::Internal) run_internal_stage();
   if (o_.only == StageSelection::Internal) return {{}, stages_, {}};

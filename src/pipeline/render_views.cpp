@@ -76,6 +76,16 @@ void remove_earlier_render(const std::filesystem::path& dir,
 
 }  // namespace
 
+void mark_render_stale(const std::filesystem::path& dir) {
+  const std::filesystem::path report = dir / "render.json";
+  if (!std::filesystem::exists(report)) return;
+  for (const char* scores : {"metrics.json", "metrics.csv"}) remove_earlier_file(dir / scores);
+  nlohmann::json record = nlohmann::json::parse(read_file(report), nullptr, false);
+  if (!record.is_object() || record.value("finished", false) == false) return;
+  record["finished"] = false;
+  write_file_atomically(report, record.dump(2) + "\n");
+}
+
 void require_render_memory(const std::vector<Camera>& cameras, double scale) {
   Intrinsics largest;
   for (const Camera& camera : cameras) {

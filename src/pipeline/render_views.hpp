@@ -37,6 +37,11 @@ RenderedViewFiles rendered_view_files(const std::filesystem::path& dir, const st
 void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
                          const RenderedView& view);
 
+// An earlier recorded render in `dir` reads as unfinished, so eval refuses it, and eval's report
+// of it goes, until the next recorded render there finishes; its names stay for that render to
+// clear. For a folder whose model is about to change.
+void mark_render_stale(const std::filesystem::path& dir);
+
 // Refuses views too large for the memory before rendering any: the kernel would kill the process
 // partway through. The CPU's alone, which holds every view's outputs and encodes the files: on a
 // GPU the free memory leaves out what LibTorch has cached, and running out there is an error

@@ -1,6 +1,7 @@
 #include "pipeline/training_stage.hpp"
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 
 #include <optional>
 
@@ -52,7 +53,8 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   const fs::path checkpoint = train::checkpoint_path(dir);
   const bool resumable = stage_recorded(dir, identity) && fs::exists(checkpoint);
   // An older run's checkpoint would be resumed by the next identical run.
-  if (!resumable) train::remove_earlier_run(dir);
+  if (!resumable && train::remove_earlier_run(dir))
+    spdlog::warn("{}: its settings or inputs changed; training it again in {}", name, dir.string());
   record_stage(dir, identity, false, 0);
   std::optional<train::Trainer> trainer;
   if (resumable) {

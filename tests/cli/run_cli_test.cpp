@@ -256,6 +256,58 @@ TEST_F(RunCli, AMissingCheckpointLeavesNoOutputFolder) {
   }
 }
 
+// A rerun stopped partway leaves no table or test renders of the earlier run that read as its
+// own, and a row trained again under other settings says so.
+TEST_F(RunCli, AStoppedRerunLeavesNothingOfTheEarlierRunThatReadsAsItsOwn) {
+  ASSERT_EQ(write_scene(16, 3, 1), 0);
+  ASSERT_EQ(run_rows("internal,external").status, 0);
+  const std::filesystem::path run = dir / "run";
+  const CliRun info = iesrgs("info " + out);
+  EXPECT_TRUE(contains(info.output, "| external only")) << info.output;
+  EXPECT_TRUE(contains(info.output, "model of internal")) << info.output;
+  EXPECT_TRUE(contains(info.output, "rows/external/point_cloud.ply")) << info.output;
+  const auto finished = [&](const char* row) {
+    const auto record =
+        nlohmann::json::parse(read_file(run / "rows" / row / "test" / "render.json"));
+    return record["finished"].get<bool>();
+  };
+  ASSERT_TRUE(finished("external"));
+
+  // Stopped in the external stage, which has no checkpoint for the network asked for.
+  const CliRun stopped = iesrgs("run " + scene + " -o " + out +
+                                " --rows internal,external --sr-model swinir --lpips none");
+  ASSERT_EQ(stopped.status, 1) << stopped.output;
+  EXPECT_FALSE(std::filesystem::exists(run / "results.md"));
+  EXPECT_FALSE(std::filesystem::exists(run / "results.csv"));
+  EXPECT_TRUE(std::filesystem::exists(run / "results.json"));  // the rows a rerun may keep
+  for (const char* row : {"internal", "external"}) {
+    EXPECT_FALSE(finished(row)) << row;
+    EXPECT_FALSE(std::filesystem::exists(run / "rows" / row / "test" / "metrics.json")) << row;
+  }
+  EXPECT_TRUE(contains(iesrgs("info " + out).output, "no results.md yet"));
+
+  // The earlier command again writes them back from its cached stages; other settings retrain.
+  ASSERT_EQ(run_rows("internal,external").status, 0);
+  EXPECT_TRUE(std::filesystem::exists(run / "results.md"));
+  EXPECT_TRUE(finished("external"));
+  const CliRun reseeded = run_rows("external", " --set seed=4");
+  ASSERT_EQ(reseeded.status, 0) << reseeded.output;
+  EXPECT_TRUE(
+      contains(reseeded.output, "fusion: its settings or inputs changed; training it again"))
+      << reseeded.output;
+}
+
+// 50 / 4 rounds up to 13 LR pixels, so the HR training views are 52 wide and the truth 50: the
+// diagnostics that compare with the truth are left out, saying why.
+TEST_F(RunCli, DiagnosticsSayWhyTheTruthIsLeftOut) {
+  ASSERT_EQ(write_scene(50, 3, 1), 0);
+  const CliRun run = run_rows("ie-srgs");
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(contains(run.output, "HR truth is 50x50, the HR training view 52x52")) << run.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "run" / "diagnostics" / "contact_sheet.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "run" / "diagnostics" / "mask_agreement.json"));
+}
+
 // The ETA is for the rows left to train: after external here, none, since ie-srgs is cached.
 TEST_F(RunCli, RowsReusedFromTheCacheAreLeftOutOfTheEta) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
