@@ -10,6 +10,7 @@
 #include "cli/commands.hpp"
 #include "cli/scene_options.hpp"
 #include "core/math.hpp"
+#include "core/progress.hpp"
 #include "io/atomic_file.hpp"
 #include "io/model_file.hpp"
 #include "io/scene.hpp"
@@ -116,9 +117,8 @@ void load_every_image(const Scene& scene) {
     images.rgb(camera);
     ++done;
     if (done % 25 == 0 || done == scene.cameras.size())
-      fmt::print(stderr, "\rdecoded {}/{} images", done, scene.cameras.size());
+      print_count_on_stderr("decoded images", done, scene.cameras.size());
   }
-  fmt::print(stderr, "\n");
   fmt::print("images      all {} decoded\n", done);
 }
 

@@ -8,6 +8,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/validators.hpp"
+#include "core/progress.hpp"
 #include "core/stopwatch.hpp"
 #include "synth/dataset_writer.hpp"
 
@@ -51,8 +52,7 @@ void add_synth_command(CLI::App& app) {
   command->callback([output, options] {
     const Stopwatch watch;
     synth::write_synth_dataset(*output, *options, [](int done, int total) {
-      fmt::print(stderr, "\rrendered {}/{} views", done, total);
-      if (done == total) fmt::print(stderr, "\n");
+      print_count_on_stderr("rendered views", size_t(done), size_t(total));
     });
     const std::string views =
         options->format == synth::SynthFormat::Colmap

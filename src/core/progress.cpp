@@ -1,6 +1,7 @@
 #include "core/progress.hpp"
 
 #include <fmt/core.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -19,6 +20,14 @@ std::string format_duration(double seconds) {
 std::string format_eta(size_t done, size_t total, double seconds) {
   if (done == 0) return "?";
   return format_duration(seconds / double(done) * double(total - std::min(done, total)));
+}
+
+void print_count_on_stderr(const char* what, size_t done, size_t total) {
+  static const bool terminal = isatty(fileno(stderr));
+  if (terminal)
+    fmt::print(stderr, "\r{} {}/{}{}", what, done, total, done == total ? "\n" : "");
+  else if (done == total)
+    fmt::print(stderr, "{} {}/{}\n", what, done, total);
 }
 
 std::string ItemPace::finished(size_t done) {
