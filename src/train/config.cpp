@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -111,7 +112,10 @@ void rescale_schedule(TrainConfig& config, int64_t iterations) {
   const double ratio = double(iterations) / double(config.iterations);
   config.densify_from = scaled(config.densify_from, ratio);
   config.densify_until = scaled(config.densify_until, ratio);
-  config.opacity_reset_every = scaled(config.opacity_reset_every, ratio);
+  // A reset undoes the opacities that densification's clones and splits start from; without a
+  // densification step since the last one it only throws training away (3DGS has 30 between two).
+  config.opacity_reset_every =
+      std::max(scaled(config.opacity_reset_every, ratio), config.densify_every);
   config.sh_increase_every = scaled(config.sh_increase_every, ratio);
   config.learning_rates.position_max_steps = iterations;
   config.iterations = iterations;

@@ -238,13 +238,15 @@ TEST(TrainCli, VerboseSaysWhatDensificationDoes) {
   TempDir dir;
   const std::string scene = (dir / "scene").string();
   ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 4 --test-views 1 --seed 2").status, 0);
-  // 400 iterations: densification from 7 until 200, every 100 iterations, so once.
+  // 400 iterations: densification from 7 until 200, every 100 iterations, so once, and the
+  // opacity reset, pro rata every 40 iterations, held to the densification step.
   const std::string train = "train " + scene + " -o " + (dir / "run").string() +
                             " --preset fast --iterations 400 --set random_points=500";
   const CliRun verbose = iesrgs("-v " + train);
   ASSERT_EQ(verbose.status, 0) << verbose.output;
   EXPECT_TRUE(contains(verbose.output, "iteration 100: densification cloned ")) << verbose.output;
-  EXPECT_TRUE(contains(verbose.output, "iteration 40: opacities reset")) << verbose.output;
+  EXPECT_TRUE(contains(verbose.output, "iteration 100: opacities reset")) << verbose.output;
+  EXPECT_FALSE(contains(verbose.output, "iteration 40: opacities reset")) << verbose.output;
   const CliRun quiet = iesrgs(train);
   ASSERT_EQ(quiet.status, 0) << quiet.output;
   EXPECT_FALSE(contains(quiet.output, "densification")) << quiet.output;

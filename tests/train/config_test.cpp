@@ -44,6 +44,12 @@ TEST(TrainConfig, ShorterRunsScaleTheScheduleTogether) {
   EXPECT_EQ(c.max_world_size, 0.1);
 }
 
+// Pro rata, `fast` at 500 iterations would reset opacities every 50, twice per densification step.
+TEST(TrainConfig, OpacityResetsAreNoMoreFrequentThanDensification) {
+  EXPECT_EQ(make_preset("fast", 500).opacity_reset_every, 100);
+  EXPECT_EQ(make_preset("fast", 1500).opacity_reset_every, 150);
+}
+
 TEST(TrainConfig, JsonRoundTripsEveryField) {
   TrainConfig c = make_preset("cpu", 1234);
   c.views_per_iteration = 3;
