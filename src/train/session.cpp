@@ -108,6 +108,12 @@ std::filesystem::path trained_model_file(const std::filesystem::path& path) {
                         (std::filesystem::exists(path / "stage.json")
                              ? "the iesrgs run, internal or fuse command that made it continues it"
                              : "the same train command with --resume continues it"));
+  // A run folder of iesrgs run holds a model per row, not one.
+  if (!std::filesystem::exists(model) && std::filesystem::is_directory(path / "rows"))
+    fail_file(path,
+              fmt::format("a run folder of iesrgs run, which holds a model per row: name "
+                          "one, e.g. {} or {} (iesrgs info lists them)",
+                          (path / "rows" / "ie-srgs").string(), (path / "internal").string()));
   return model;
 }
 

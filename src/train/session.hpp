@@ -52,7 +52,7 @@ void write_point_clouds(const std::filesystem::path& dir, const Trainer& trainer
 bool remove_earlier_run(const std::filesystem::path& dir);
 
 // A trained model given as its training folder (its point_cloud.ply) or as a model file. Throws
-// Error for a folder whose training has not finished.
+// Error for a folder whose training has not finished, and for a run folder of iesrgs run.
 std::filesystem::path trained_model_file(const std::filesystem::path& path);
 
 }  // namespace iesrgs::train

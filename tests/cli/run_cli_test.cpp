@@ -266,6 +266,10 @@ TEST_F(RunCli, AStoppedRerunLeavesNothingOfTheEarlierRunThatReadsAsItsOwn) {
   EXPECT_TRUE(contains(info.output, "| external only")) << info.output;
   EXPECT_TRUE(contains(info.output, "model of internal")) << info.output;
   EXPECT_TRUE(contains(info.output, "rows/external/point_cloud.ply")) << info.output;
+  // Where one model is wanted, a run folder is named as such.
+  const CliRun whole = iesrgs("export " + out + " " + (dir / "x.spz").string());
+  EXPECT_EQ(whole.status, 1);
+  EXPECT_TRUE(contains(last_line(whole.output), "a run folder of iesrgs run")) << whole.output;
   const auto finished = [&](const char* row) {
     const auto record =
         nlohmann::json::parse(read_file(run / "rows" / row / "test" / "render.json"));
