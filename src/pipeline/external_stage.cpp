@@ -88,8 +88,9 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
                                              const ExternalOptions& options, const fs::path& dir) {
   if (options.sr_model == "auto") fail("run_external_stage: resolve the SR model first");
   const std::string stage = stage_identity(options);
-  const fs::path record_path = dir / "external.json";
+  const fs::path record_path = dir / "external.json", seconds_path = dir / "seconds.json";
   nlohmann::json record = read_stage_record(record_path);
+  nlohmann::json seconds_of = read_stage_record(seconds_path);
   std::unique_ptr<priors::sr::SrNet> sr;  // loaded only when some view needs it
   std::unique_ptr<priors::depth::DepthNet> depth;
   bool loaded = false;
@@ -98,12 +99,16 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
   std::vector<ExternalView> views;
   size_t computed = 0;
   const Stopwatch watch;
+  Stopwatch since_computed;  // the time a computed view took, from the one before
   for (size_t i = 0; i < cameras.size(); ++i) {
     const Camera& camera = *cameras[i];
-    const ExternalView view = external_view(camera, options, dir);
-    views.push_back(view);
+    ExternalView& view = views.emplace_back(external_view(camera, options, dir));
     const std::string fingerprint = view_fingerprint(stage, images, camera);
-    if (view_cached(record, fingerprint, view, camera, options.scale)) continue;
+    if (view_cached(record, fingerprint, view, camera, options.scale)) {
+      const nlohmann::json recorded = seconds_of.value(camera.name, nlohmann::json());
+      if (recorded.is_number()) view.seconds = recorded.get<double>();
+      continue;
+    }
     if (!loaded) {
       sr = priors::sr::make_sr_net(options.sr_model, options.sr_weights, options.scale);
       depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights);
@@ -123,6 +128,9 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
     }
     record[camera.name] = fingerprint;
     write_file_atomically(record_path, record.dump(1) + "\n");
+    view.seconds = since_computed.lap();
+    seconds_of[camera.name] = view.seconds;
+    write_file_atomically(seconds_path, seconds_of.dump(1) + "\n");
     ++computed;
     const double seconds = watch.seconds();
     // The views left may be cached: the estimate errs long.

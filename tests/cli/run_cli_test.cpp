@@ -135,6 +135,11 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   const CliRun second = iesrgs(command);
   ASSERT_EQ(second.status, 0) << second.output;
   EXPECT_TRUE(contains(second.output, "reusing the finished model")) << second.output;
+  // The cached stages count the time they took when they ran, the external ones too.
+  const auto reused = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+  EXPECT_GT(results["stages"]["external_seconds"].get<double>(), 0.0);
+  for (const char* stage : {"external_seconds", "internal_training_seconds"})
+    EXPECT_EQ(reused["stages"][stage], results["stages"][stage]) << stage;
   EXPECT_FALSE(contains(second.output, "it/s |")) << second.output;
   // No row trained, so no pace to give an ETA by.
   EXPECT_TRUE(contains(second.output, "HR rows: 5 of 6 done in ")) << second.output;
