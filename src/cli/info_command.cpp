@@ -96,14 +96,7 @@ void print_run_summary(const std::filesystem::path& run) {
     fmt::print("{}", read_file(table));  // ends in a newline
   else
     fmt::print("no results.md yet: the run has not finished\n");
-  std::vector<std::filesystem::path> models;
-  for (const auto& row : std::filesystem::directory_iterator(run / "rows"))
-    if (std::filesystem::exists(train::model_path(row.path())))
-      models.push_back(train::model_path(row.path()));
-  if (std::filesystem::exists(train::model_path(run / "internal")))
-    models.push_back(train::model_path(run / "internal"));
-  std::sort(models.begin(), models.end());
-  for (const std::filesystem::path& model : models)
+  for (const std::filesystem::path& model : train::run_folder_models(run))
     fmt::print("model of {:<16} {}\n", model.parent_path().filename().string(), model.string());
 }
 
@@ -147,7 +140,7 @@ void add_info_command(CLI::App& app) {
       print_model_summary(train::trained_model_file(path));
       return;
     }
-    if (!is_scene(path) && std::filesystem::is_directory(path / "rows")) {
+    if (!is_scene(path) && train::is_run_folder(path)) {
       print_run_summary(path);
       return;
     }

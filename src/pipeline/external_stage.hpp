@@ -26,8 +26,9 @@ struct ExternalView {
   std::string name;
   std::filesystem::path image;  // <dir>/image/<name>.png, E_image
   std::filesystem::path depth;  // <dir>/depth/<name>.npy, E_depth; empty without a depth model
-  // What computing it took when it ran, the network's loading included for the first view a run
-  // computed (<dir>/seconds.json); 0 for a view cached before the time was recorded.
+  // What computing it took when it ran (<dir>/seconds.json), from the view computed before it or
+  // the stage's start: the network's loading and the checks of cached views between included. 0
+  // for a view cached before the time was recorded.
   double seconds = 0;
 };
 

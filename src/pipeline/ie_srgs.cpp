@@ -244,14 +244,23 @@ void Pipeline::check_cached_inputs() const {
 
 // An interrupted run leaves no table or test renders of an earlier one that read as its own: the
 // table is written again when the run finishes, each row's test views when the row is scored.
-// results.json stays, for keep_earlier_rows.
+// `iesrgs internal` scores nothing, so it does this only when it makes the internal model again,
+// whose row's renders then show a model that is gone. results.json stays, for keep_earlier_rows.
 void Pipeline::forget_earlier_results() const {
+  const bool scoring = o_.only != StageSelection::Internal;
+  const bool internal_changes =
+      (!scoring || rows_use_internal_references()) &&
+      !internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
+                              o_.output / "internal");
+  if (!scoring && !internal_changes) return;
   for (const char* table : {"results.md", "results.csv"}) {
     std::error_code ec;
     fs::remove(o_.output / table, ec);
     if (ec) fail_file(o_.output / table, "cannot be removed before a new run: " + ec.message());
   }
-  for (const std::string& id : rows_) mark_render_stale(o_.output / "rows" / id / "test");
+  if (internal_changes) mark_render_stale(o_.output / "rows" / "internal" / "test");
+  if (scoring)
+    for (const std::string& id : rows_) mark_render_stale(o_.output / "rows" / id / "test");
 }
 
 // The stages' time is what computing their views took when it ran, as a reused training counts
@@ -517,7 +526,7 @@ void Pipeline::write_mask_agreement(const FusionSetup& setup) const {
 RunResult Pipeline::run() {
   const Stopwatch watch;
   if (o_.only == StageSelection::Fusion) check_cached_inputs();
-  if (o_.only != StageSelection::Internal) forget_earlier_results();
+  forget_earlier_results();
   if (o_.only != StageSelection::Internal) run_external_stages();
   if (rows_use_internal_references() || o_.only == StageSelection::Internal) run_internal_stage();
   if (o_.only == StageSelection::Internal) return {{}, stages_, {}};

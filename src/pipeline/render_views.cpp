@@ -81,7 +81,7 @@ void mark_render_stale(const std::filesystem::path& dir) {
   if (!std::filesystem::exists(report)) return;
   for (const char* scores : {"metrics.json", "metrics.csv"}) remove_earlier_file(dir / scores);
   nlohmann::json record = nlohmann::json::parse(read_file(report), nullptr, false);
-  if (!record.is_object() || record.value("finished", false) == false) return;
+  if (!record.is_object()) record = nlohmann::json::object();  // damaged: no names to keep
   record["finished"] = false;
   write_file_atomically(report, record.dump(2) + "\n");
 }

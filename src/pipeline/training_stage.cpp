@@ -51,10 +51,14 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   }
   remove_stale_temporaries(dir);  // a killed run's half-written checkpoint, say
   const fs::path checkpoint = train::checkpoint_path(dir);
-  const bool resumable = stage_recorded(dir, identity) && fs::exists(checkpoint);
-  // An older run's checkpoint would be resumed by the next identical run.
-  if (!resumable && train::remove_earlier_run(dir))
+  const bool recorded = stage_recorded(dir, identity);
+  const bool resumable = recorded && fs::exists(checkpoint);
+  // A model of other settings or inputs is replaced; one stopped before its first checkpoint
+  // simply starts again.
+  if (!recorded && fs::exists(train::model_path(dir)))
     spdlog::warn("{}: its settings or inputs changed; training it again in {}", name, dir.string());
+  // An older run's checkpoint would be resumed by the next identical run.
+  if (!resumable) train::remove_earlier_run(dir);
   record_stage(dir, identity, false, 0);
   std::optional<train::Trainer> trainer;
   if (resumable) {

@@ -108,13 +108,31 @@ std::filesystem::path trained_model_file(const std::filesystem::path& path) {
                         (std::filesystem::exists(path / "stage.json")
                              ? "the iesrgs run, internal or fuse command that made it continues it"
                              : "the same train command with --resume continues it"));
-  // A run folder of iesrgs run holds a model per row, not one.
-  if (!std::filesystem::exists(model) && std::filesystem::is_directory(path / "rows"))
-    fail_file(path,
-              fmt::format("a run folder of iesrgs run, which holds a model per row: name "
-                          "one, e.g. {} or {} (iesrgs info lists them)",
-                          (path / "rows" / "ie-srgs").string(), (path / "internal").string()));
+  if (!std::filesystem::exists(model) && is_run_folder(path)) {
+    const std::vector<std::filesystem::path> models = run_folder_models(path);
+    fail_file(path, models.empty() ? std::string("a run folder of iesrgs run, with no model yet")
+                                   : fmt::format("a run folder of iesrgs run, which holds a model "
+                                                 "per row: name one, e.g. {} (iesrgs info lists "
+                                                 "them)",
+                                                 models.front().parent_path().string()));
+  }
   return model;
+}
+
+bool is_run_folder(const std::filesystem::path& dir) {
+  return std::filesystem::is_directory(dir / "rows") ||
+         std::filesystem::exists(dir / "internal" / "stage.json");
+}
+
+std::vector<std::filesystem::path> run_folder_models(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> models;
+  if (std::filesystem::is_directory(dir / "rows"))
+    for (const auto& row : std::filesystem::directory_iterator(dir / "rows"))
+      if (std::filesystem::exists(model_path(row.path()))) models.push_back(model_path(row.path()));
+  if (std::filesystem::exists(model_path(dir / "internal")))
+    models.push_back(model_path(dir / "internal"));
+  std::sort(models.begin(), models.end());
+  return models;
 }
 
 }  // namespace iesrgs::train

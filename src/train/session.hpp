@@ -55,4 +55,10 @@ bool remove_earlier_run(const std::filesystem::path& dir);
 // Error for a folder whose training has not finished, and for a run folder of iesrgs run.
 std::filesystem::path trained_model_file(const std::filesystem::path& path);
 
+// A run folder of iesrgs run (or of iesrgs internal alone): rows/, or the internal stage.
+bool is_run_folder(const std::filesystem::path& dir);
+
+// The trained models in a run folder, each row's (rows/<row>/) and the internal model, sorted.
+std::vector<std::filesystem::path> run_folder_models(const std::filesystem::path& dir);
+
 }  // namespace iesrgs::train

@@ -135,6 +135,7 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   const CliRun second = iesrgs(command);
   ASSERT_EQ(second.status, 0) << second.output;
   EXPECT_TRUE(contains(second.output, "reusing the finished model")) << second.output;
+  EXPECT_FALSE(contains(second.output, "settings or inputs changed")) << second.output;
   // The cached stages count the time they took when they ran, the external ones too.
   const auto reused = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
   EXPECT_GT(results["stages"]["external_seconds"].get<double>(), 0.0);
@@ -232,6 +233,9 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   ASSERT_EQ(internal.status, 0) << internal.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "run" / "internal/sr/rgb/r_0.png"));
   EXPECT_FALSE(std::filesystem::exists(dir / "run" / "results.json"));
+  const CliRun info = iesrgs("info " + out);  // a run folder already, of the internal model
+  EXPECT_TRUE(contains(info.output, "no results.md yet")) << info.output;
+  EXPECT_TRUE(contains(info.output, "model of internal")) << info.output;
 
   // fuse trains the HR rows alone: an internal model of other settings is refused, not retrained.
   const std::string other_schedule =
@@ -304,6 +308,21 @@ TEST_F(RunCli, AStoppedRerunLeavesNothingOfTheEarlierRunThatReadsAsItsOwn) {
   EXPECT_TRUE(
       contains(reseeded.output, "fusion: its settings or inputs changed; training it again"))
       << reseeded.output;
+  // A damaged record is rendered over.
+  write_file_atomically(run / "rows" / "external" / "test" / "render.json", R"({"finished": 1})");
+  const CliRun damaged = run_rows("external", " --set seed=4");
+  ASSERT_EQ(damaged.status, 0) << damaged.output;
+  EXPECT_FALSE(contains(damaged.output, "settings or inputs changed")) << damaged.output;
+  EXPECT_TRUE(finished("external"));
+
+  // iesrgs internal leaves the table alone while its model stays, and not once it changes.
+  const std::string internal = "internal " + scene + " -o " + out + kTinySchedule;
+  ASSERT_EQ(iesrgs(internal).status, 0);
+  EXPECT_TRUE(std::filesystem::exists(run / "results.md"));
+  EXPECT_TRUE(finished("internal"));
+  ASSERT_EQ(iesrgs(internal + " --internal-set seed=7").status, 0);
+  EXPECT_FALSE(std::filesystem::exists(run / "results.md"));
+  EXPECT_FALSE(finished("internal"));
 }
 
 // 50 / 4 rounds up to 13 LR pixels, so the HR training views are 52 wide and the truth 50: the
