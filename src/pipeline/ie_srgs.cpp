@@ -248,10 +248,11 @@ void Pipeline::check_cached_inputs() const {
 // whose row's renders then show a model that is gone. results.json stays, for keep_earlier_rows.
 void Pipeline::forget_earlier_results() const {
   const bool scoring = o_.only != StageSelection::Internal;
+  // The model alone: the check of the SR-splatting renders decodes every one of them, which
+  // run_internal_stage does anyway.
   const bool internal_changes =
       (!scoring || rows_use_internal_references()) &&
-      !internal_stage_current(lr_scene_, train_digest_, o_.internal_config, o_.scale,
-                              o_.output / "internal");
+      !internal_model_current(lr_scene_, train_digest_, o_.internal_config, o_.output / "internal");
   if (!scoring && !internal_changes) return;
   for (const char* table : {"results.md", "results.csv"}) {
     std::error_code ec;

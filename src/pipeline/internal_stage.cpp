@@ -65,10 +65,15 @@ InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train
   return stage;
 }
 
+bool internal_model_current(const Scene& lr_scene, const std::string& train_digest,
+                            const train::TrainConfig& config, const std::filesystem::path& dir) {
+  return training_stage_current(dir, internal_params(lr_scene, train_digest), config);
+}
+
 bool internal_stage_current(const Scene& lr_scene, const std::string& train_digest,
                             const train::TrainConfig& config, int scale,
                             const std::filesystem::path& dir) {
-  return training_stage_current(dir, internal_params(lr_scene, train_digest), config) &&
+  return internal_model_current(lr_scene, train_digest, config, dir) &&
          stage_finished(dir / "sr", sr_params(stage_seconds(dir), scale)) &&
          renders_present(dir / "sr", lr_scene, scale);
 }

@@ -25,6 +25,11 @@ InternalStage run_internal_stage(const Scene& lr_scene, const std::string& train
                                  ViewImages& lr_images, const train::TrainConfig& config, int scale,
                                  const std::filesystem::path& dir);
 
+// Whether <dir> holds a finished internal model for these settings, which run_internal_stage
+// would reuse; reads its record alone.
+bool internal_model_current(const Scene& lr_scene, const std::string& train_digest,
+                            const train::TrainConfig& config, const std::filesystem::path& dir);
+
 // Whether <dir> holds a finished internal model for these settings and its SR-splatting renders
 // at `scale`, so that run_internal_stage would only load them.
 bool internal_stage_current(const Scene& lr_scene, const std::string& train_digest,
