@@ -1,5 +1,6 @@
 #include "io/atomic_file.hpp"
 
+#include <fmt/core.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -79,6 +80,13 @@ void write_file_atomically(const fs::path& path, const std::string& bytes) {
     out.close();
     if (!out) fail_file(path, "write failed (disk full or not writable?)");
   });
+}
+
+bool remove_earlier_output(const fs::path& file, std::string_view left_by) {
+  std::error_code ec;
+  const bool removed = fs::remove(file, ec);
+  if (ec) fail_file(file, fmt::format("{}, and cannot be removed: {}", left_by, ec.message()));
+  return removed;
 }
 
 std::string read_file(const fs::path& path) {

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <string_view>
 
 namespace iesrgs {
 
@@ -18,6 +19,11 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
 // Removes the temporaries that processes killed mid-write (a second Ctrl-C, kill -9, the OOM
 // killer) left in `folder` (not below it): those of our outputs' kinds whose writer is gone.
 void remove_stale_temporaries(const std::filesystem::path& folder);
+
+// Removes `file`, an earlier output about to be replaced, when it exists; returns whether it did.
+// Throws Error naming the file when it cannot be removed, saying what left it (`left_by`, e.g.
+// "left by an earlier render").
+bool remove_earlier_output(const std::filesystem::path& file, std::string_view left_by);
 
 // Whole file into memory; throws Error naming the file when it cannot be read.
 std::string read_file(const std::filesystem::path& path);

@@ -254,11 +254,8 @@ void Pipeline::forget_earlier_results() const {
       (!scoring || rows_use_internal_references()) &&
       !internal_model_current(lr_scene_, train_digest_, o_.internal_config, o_.output / "internal");
   if (!scoring && !internal_changes) return;
-  for (const char* table : {"results.md", "results.csv"}) {
-    std::error_code ec;
-    fs::remove(o_.output / table, ec);
-    if (ec) fail_file(o_.output / table, "cannot be removed before a new run: " + ec.message());
-  }
+  for (const char* table : {"results.md", "results.csv"})
+    remove_earlier_output(o_.output / table, "left by an earlier run");
   if (internal_changes) mark_render_stale(o_.output / "rows" / "internal" / "test");
   if (scoring)
     for (const std::string& id : rows_) mark_render_stale(o_.output / "rows" / id / "test");

@@ -46,9 +46,12 @@ bool inside_folder(const std::string& name) {
 }
 
 void remove_earlier_file(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::remove(file, ec) && ec)
-    fail_file(file, "left by an earlier render, and cannot be removed: " + ec.message());
+  remove_earlier_output(file, "left by an earlier render");
+}
+
+// Eval's report of an earlier render in `dir`, from its default location.
+void remove_eval_report(const std::filesystem::path& dir) {
+  for (const char* scores : {"metrics.json", "metrics.csv"}) remove_earlier_file(dir / scores);
 }
 
 // What an earlier render into the folder leaves that would mix with this one, of the views
@@ -59,7 +62,7 @@ void remove_earlier_render(const std::filesystem::path& dir,
                            const std::vector<std::string>& names) {
   const std::filesystem::path report = dir / "render.json";
   if (!std::filesystem::exists(report)) return;
-  for (const char* scores : {"metrics.json", "metrics.csv"}) remove_earlier_file(dir / scores);
+  remove_eval_report(dir);
   const nlohmann::json earlier = nlohmann::json::parse(read_file(report), nullptr, false);
   if (!earlier.is_object() || !earlier.contains("names") || !earlier["names"].is_array()) return;
   for (const nlohmann::json& name : earlier["names"]) {
@@ -79,7 +82,7 @@ void remove_earlier_render(const std::filesystem::path& dir,
 void mark_render_stale(const std::filesystem::path& dir) {
   const std::filesystem::path report = dir / "render.json";
   if (!std::filesystem::exists(report)) return;
-  for (const char* scores : {"metrics.json", "metrics.csv"}) remove_earlier_file(dir / scores);
+  remove_eval_report(dir);
   nlohmann::json record = nlohmann::json::parse(read_file(report), nullptr, false);
   if (!record.is_object()) record = nlohmann::json::object();  // damaged: no names to keep
   record["finished"] = false;

@@ -152,9 +152,7 @@ void replace_earlier_scene(const fs::path& dir) {
                                  name, kRecord));
     present.push_back(dir / name);
   }
-  for (const fs::path& file : present)
-    if (!fs::remove(file, ec) && ec)
-      fail_file(file, "left by an earlier scene, and cannot be removed: " + ec.message());
+  for (const fs::path& file : present) remove_earlier_output(file, "left by an earlier scene");
   // sparse/ alone makes a COLMAP scene; kept when it holds anything else.
   for (const fs::path& folder : {dir / "sparse" / "0", dir / "sparse"}) fs::remove(folder, ec);
 }

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/math.hpp"
+#include "io/atomic_file.hpp"
 #include "io/image_tensor.hpp"
 #include "io/model_file.hpp"
 #include "io/ply.hpp"
@@ -91,11 +92,8 @@ bool remove_earlier_run(const std::filesystem::path& dir) {
   bool removed = false;
   for (const std::filesystem::path& file :
        {checkpoint_path(dir), dir / "train_log.csv", dir / "cameras.json", dir / "training.json",
-        model_path(dir), dir / "point_cloud_filter_baked.ply"}) {
-    std::error_code ec;
-    removed |= std::filesystem::remove(file, ec);
-    if (ec) fail_file(file, "cannot be removed before a new run: " + ec.message());
-  }
+        model_path(dir), dir / "point_cloud_filter_baked.ply"})
+    removed |= remove_earlier_output(file, "left by an earlier run");
   return removed;
 }
 
