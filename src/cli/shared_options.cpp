@@ -4,6 +4,7 @@
 
 #include "cli/validators.hpp"
 #include "core/device.hpp"
+#include "core/error.hpp"
 
 namespace iesrgs::cli {
 
@@ -45,6 +46,16 @@ void add_tile_options(CLI::App& command, priors::sr::TileOptions& tiles) {
                   "Input pixels shared by neighbouring SR tiles, cross-faded")
       ->capture_default_str()
       ->check(kNonNegative);
+}
+
+void refuse_set_beside_option(const CLI::Option& option, const std::string& key,
+                              const std::vector<std::string>& assignments,
+                              const std::string& set_flag) {
+  if (option.count() == 0) return;
+  for (const std::string& assignment : assignments)
+    if (assignment.rfind(key + "=", 0) == 0)
+      fail("{} and {} {} both set {}: give one of them", option.get_name(), set_flag, assignment,
+           key);
 }
 
 void use_device(const std::string& device) {

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <string>
+#include <vector>
 
 #include "priors/sr/tiling.hpp"
 
@@ -21,6 +22,12 @@ void add_gray_background_option(CLI::App& command, float& gray);
 
 // Adds --tile and --tile-overlap, how the SR networks' commands cut an image, stored in `tiles`.
 void add_tile_options(CLI::App& command, priors::sr::TileOptions& tiles);
+
+// Throws Error when `option` was given and one of `assignments`, the values of `set_flag`, sets
+// `key`, the training parameter that option sets: which of the two should win would be a guess.
+void refuse_set_beside_option(const CLI::Option& option, const std::string& key,
+                              const std::vector<std::string>& assignments,
+                              const std::string& set_flag);
 
 // Makes `device` this process's compute device (core/device.hpp) and says which it is. Throws
 // Error when it names a GPU this build or machine cannot use.

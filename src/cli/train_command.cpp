@@ -165,13 +165,15 @@ void add_train_command(CLI::App& app) {
   CLI::Option* preset = defines_run(command->add_option(
       "--preset", args->preset, "Schedule: paper (30k, GPU), cpu (10k), fast (3k)"));
   preset->capture_default_str();
-  defines_run(command->add_option("--iterations", args->iterations,
-                                  "Iterations; the preset's schedule is rescaled to fit"))
-      ->check(kPositive);
-  defines_run(command->add_option("--mv", args->views_per_iteration,
-                                  "Views per iteration (multi-view regulation K; 1 = plain 3DGS)"))
-      ->check(kPositive);
-  defines_run(command->add_option("--seed", args->seed, "Random seed"))->check(kNonNegative);
+  CLI::Option* iterations = defines_run(command->add_option(
+      "--iterations", args->iterations, "Iterations; the preset's schedule is rescaled to fit"));
+  iterations->check(kPositive);
+  CLI::Option* mv = defines_run(
+      command->add_option("--mv", args->views_per_iteration,
+                          "Views per iteration (multi-view regulation K; 1 = plain 3DGS)"));
+  mv->check(kPositive);
+  CLI::Option* seed = defines_run(command->add_option("--seed", args->seed, "Random seed"));
+  seed->check(kNonNegative);
   defines_run(
       command->add_option("--config", args->config_file, "JSON file of training parameters"));
   defines_run(command->add_option(
@@ -183,7 +185,10 @@ void add_train_command(CLI::App& app) {
   command->add_flag("--resume", args->resume,
                     "Continue the run in --output from its checkpoint, with its saved config");
   add_device_option(*command, args->device);
-  command->callback([args, run_options, preset] {
+  command->callback([args, run_options, preset, iterations, mv, seed] {
+    refuse_set_beside_option(*iterations, "iterations", args->assignments, "--set");
+    refuse_set_beside_option(*mv, "views_per_iteration", args->assignments, "--set");
+    refuse_set_beside_option(*seed, "seed", args->assignments, "--set");
     for (const CLI::Option* option : run_options) args->run_options_given |= option->count() > 0;
     args->preset_given = preset->count() > 0;
     run_train(*args);

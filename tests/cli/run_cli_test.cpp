@@ -220,6 +220,15 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_TRUE(contains(last_line(unused.output), "takes its D-SSIM weight from --dssim"))
       << unused.output;
 
+  const CliRun twice = iesrgs("run " + scene + " -o " + out +
+                              " --internal-mv 2 --internal-set views_per_iteration=3");
+  EXPECT_EQ(twice.status, 1);
+  EXPECT_TRUE(contains(last_line(twice.output),
+                       "--internal-mv and --internal-set views_per_iteration=3 both set "
+                       "views_per_iteration"))
+      << twice.output;
+  EXPECT_EQ(iesrgs("run " + scene + " -o " + out + " --seed 1 --set seed=2").status, 1);
+
   const CliRun seed = iesrgs("run " + scene + " -o " + out + " --seed -5");
   EXPECT_NE(seed.status, 0);
   EXPECT_TRUE(contains(seed.output, "--seed: must be at least 0, got -5")) << seed.output;

@@ -355,6 +355,12 @@ TEST(TrainCli, BadConfigAndMissingCheckpointAreOneLineErrors) {
   EXPECT_EQ(typo.status, 1);
   EXPECT_TRUE(contains(last_line(typo.output), "unknown training parameter \"itrations\""))
       << typo.output;
+  // An option and a --set of the parameter it sets: neither silently wins.
+  const CliRun twice =
+      iesrgs("train " + scene + " -o " + (dir / "a").string() + " --seed 2 --set seed=9");
+  EXPECT_EQ(twice.status, 1);
+  EXPECT_TRUE(contains(last_line(twice.output), "--seed and --set seed=9 both set seed"))
+      << twice.output;
   const CliRun resume = iesrgs("train " + scene + " -o " + (dir / "b").string() + " --resume");
   EXPECT_EQ(resume.status, 1);
   EXPECT_TRUE(contains(last_line(resume.output), "config.json: missing")) << resume.output;
