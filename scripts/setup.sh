@@ -28,7 +28,8 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libstb-dev libfmt-dev libspdlog-dev zlib1g-dev libzstd-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
-# npm fetches the default super-resolution model (below); a Node.js install may already ship it.
+# npm fetches the super-resolution model that `auto` takes without SAFMN's checkpoint (below); a
+# Node.js install may already ship it.
 command -v npm >/dev/null || PACKAGES+=(npm)
 
 scripts/apt-install.sh "${PACKAGES[@]}"

@@ -263,7 +263,7 @@ void run_adam_bench(const AdamBenchArgs& args) {
 
 void add_repeat_options(CLI::App* command, RepeatArgs& repeat) {
   // More threads than any machine has cores only makes OpenMP spawn and wait for them.
-  command->add_option("--threads", repeat.threads, "OpenMP threads (default: all cores)")
+  command->add_option("--threads", repeat.threads, "OpenMP threads (0, the default: all cores)")
       ->check(kNonNegative)
       ->check(CLI::Range(0, 1024));
   command->add_option("--iterations", repeat.iterations, "Timed iterations")

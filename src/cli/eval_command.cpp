@@ -184,6 +184,8 @@ void run_eval(const EvalArgs& args) {
                                                    : std::filesystem::path(args.output);
   // A folder given as the output holds the report under the default name, not as ".json".
   if (!base.has_filename() || std::filesystem::is_directory(base)) base /= "metrics";
+  // The report is two files, so a path naming one of them names both.
+  if (base.extension() == ".json" || base.extension() == ".csv") base.replace_extension();
   // A mean over part of a split is not the split's score: say so, in the report and next to the
   // numbers.
   report.unscored = truth.unscored(report.views);
@@ -216,7 +218,7 @@ void add_eval_command(CLI::App& app) {
       ->required();
   command
       ->add_option("-o,--output", args->output,
-                   "Report path without extension, or a folder for metrics.json and .csv "
+                   "Report path (.json and .csv are added), or a folder for metrics.json and .csv "
                    "(default <renders>/metrics)")
       ->check(kNonEmptyPath);
   command->add_option("--split", args->split, "Scene split to compare with")

@@ -118,8 +118,10 @@ void add_fusion_options(CLI::App& command, RunArgs& args) {
       ->capture_default_str()
       ->check(kUnitInterval);
   command
-      .add_option("--threshold", o.threshold,
-                  "Discrepancy threshold T (default 0.6 synthetic, 0.9 real scenes)")
+      .add_option(
+          "--threshold", o.threshold,
+          "Discrepancy threshold T (default 0.6 for NeRF Synthetic layouts, 0.9 for captures: "
+          "COLMAP, transforms.json)")
       ->check(kNonNegative);
   command.add_option("--init", o.init, "HR model start: scene (as 3DGS) or internal")
       ->check(CLI::IsMember({"scene", "internal"}))
@@ -142,6 +144,10 @@ void add_pipeline_command(CLI::App& app, const std::string& name, const std::str
   auto args = std::make_shared<RunArgs>();
   CLI::App* command = app.add_subcommand(name, description);
   args->scene.add_to(*command);
+  command->get_option("--downscale")
+      ->description(
+          "HR ground truth at 1/k of the stored images, LR input at 1/(k*s): <images>_<k>/ "
+          "when present, else a PIL-compatible bicubic resize");
   pipeline::RunOptions& o = args->options;
   command->add_option("-o,--output", args->output, "Run folder (stages, rows, results)")
       ->required()

@@ -64,6 +64,13 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
   EXPECT_FALSE(std::filesystem::exists(dir / "same" / "metrics.json"));
   EXPECT_FALSE(std::filesystem::exists(dir / "same" / "metrics.csv"));
   ASSERT_EQ(iesrgs("eval " + same_size + " " + scene).status, 0);
+  // A report path naming its .json names the pair.
+  ASSERT_EQ(iesrgs("eval --lpips none " + same_size + " " + scene + " -o " +
+                   (dir / "report.json").string())
+                .status,
+            0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "report.json"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "report.csv"));
 
   const CliRun mismatch = iesrgs("eval " + renders + " " + scene);
   EXPECT_EQ(mismatch.status, 1);
