@@ -1,11 +1,18 @@
 #include "io/camera.hpp"
 
+#include <fmt/core.h>
+
 #include <cmath>
 
 namespace iesrgs {
 
 const char* split_name(Split split) {
   return split == Split::Train ? "train" : "test";
+}
+
+std::string Distortion::terms_beyond_opencv() const {
+  if (!beyond_opencv()) return {};
+  return fmt::format(" {:.9g} {:.9g} {:.9g} {:.9g}", k3, k4, k5, k6);
 }
 
 Intrinsics Intrinsics::scaled(double scale) const {

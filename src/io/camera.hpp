@@ -18,19 +18,27 @@ constexpr int kMaxImageSide = 1 << 16;
 
 const char* split_name(Split split);
 
-// Lens distortion of the stored image, in the OpenCV / COLMAP model
-// (radial k1, k2; tangential p1, p2). All zero means the image is already pinhole.
+// Lens distortion of the stored image, in the OpenCV / COLMAP model: radial k1, k2, k3 over
+// k4, k5, k6 (FULL_OPENCV's rational model; OPENCV's is k1, k2 alone), tangential p1, p2. All zero
+// means the image is already pinhole.
 struct Distortion {
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0;
+  double k3 = 0, k4 = 0, k5 = 0, k6 = 0;
 
-  bool any() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0; }
-  // Maps normalized undistorted coordinates (x, y) to distorted ones.
+  bool any() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || beyond_opencv(); }
+  bool beyond_opencv() const { return k3 != 0 || k4 != 0 || k5 != 0 || k6 != 0; }
+  // Maps normalized undistorted coordinates (x, y) to distorted ones. Zero terms add exact zeros,
+  // so an OPENCV lens maps as it did before the other terms were read.
   void apply(double x, double y, double& xd, double& yd) const {
     const double r2 = x * x + y * y;
-    const double radial = 1 + k1 * r2 + k2 * r2 * r2;
+    const double radial = (1 + k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2) /
+                          (1 + k4 * r2 + k5 * r2 * r2 + k6 * r2 * r2 * r2);
     xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
     yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
   }
+  // " k3 k4 k5 k6" for the keys of what an undistortion made, or nothing when they are all zero:
+  // the keys of OPENCV lenses stay those made before these terms were read.
+  std::string terms_beyond_opencv() const;
 };
 
 struct Intrinsics {

@@ -107,15 +107,16 @@ namespace {
 // has no such term (zero). The SIMPLE_ models share one focal length between x and y.
 struct PinholeLayout {
   std::string_view model;
-  int fx, fy, cx, cy, k1, k2, p1, p2;
+  int fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6;
 };
 
 constexpr PinholeLayout kSupportedModels[] = {
-    {"SIMPLE_PINHOLE", 0, 0, 1, 2, -1, -1, -1, -1},
-    {"PINHOLE", 0, 1, 2, 3, -1, -1, -1, -1},
-    {"SIMPLE_RADIAL", 0, 0, 1, 2, 3, -1, -1, -1},
-    {"RADIAL", 0, 0, 1, 2, 3, 4, -1, -1},
-    {"OPENCV", 0, 1, 2, 3, 4, 5, 6, 7},
+    {"SIMPLE_PINHOLE", 0, 0, 1, 2, -1, -1, -1, -1, -1, -1, -1, -1},
+    {"PINHOLE", 0, 1, 2, 3, -1, -1, -1, -1, -1, -1, -1, -1},
+    {"SIMPLE_RADIAL", 0, 0, 1, 2, 3, -1, -1, -1, -1, -1, -1, -1},
+    {"RADIAL", 0, 0, 1, 2, 3, 4, -1, -1, -1, -1, -1, -1},
+    {"OPENCV", 0, 1, 2, 3, 4, 5, 6, 7, -1, -1, -1, -1},
+    {"FULL_OPENCV", 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11},
 };
 
 const PinholeLayout& supported_layout(const ColmapCamera& camera, const fs::path& cameras_file) {
@@ -153,7 +154,8 @@ Lens lens_of(const ColmapCamera& camera, const fs::path& cameras_file) {
                      param(layout.cy)};
   if (!(lens.intrinsics.fx > 0 && lens.intrinsics.fy > 0))
     fail_file(cameras_file, fmt::format("camera {}: focal length must be positive", camera.id));
-  lens.distortion = {param(layout.k1), param(layout.k2), param(layout.p1), param(layout.p2)};
+  lens.distortion = {param(layout.k1), param(layout.k2), param(layout.p1), param(layout.p2),
+                     param(layout.k3), param(layout.k4), param(layout.k5), param(layout.k6)};
   return lens;
 }
 

@@ -54,9 +54,24 @@ SceneFormat detect_format(const fs::path& root) {
   return SceneFormat::None;
 }
 
+// A NeRF Synthetic split file read as a nerfstudio scene would take every 8th of its views for
+// test and the other split not at all.
+void refuse_blender_split_file(const fs::path& file) {
+  const std::string name = file.filename().string();
+  if (name != "transforms_train.json" && name != "transforms_test.json" &&
+      name != "transforms_val.json")
+    return;
+  const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  if (detect_format(folder) == SceneFormat::Blender)
+    fail_file(file, fmt::format("one split of a NeRF Synthetic scene: give the scene's folder, {}, "
+                                "which reads transforms_train.json and transforms_test.json",
+                                folder.string()));
+}
+
 Scene read_any_format(const fs::path& root, const SceneOptions& options) {
   switch (detect_format(root)) {
     case SceneFormat::NerfstudioFile:
+      refuse_blender_split_file(root);
       return read_nerfstudio_scene(root, options);
     case SceneFormat::Blender:
       return read_blender_scene(root, options);

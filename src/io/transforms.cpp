@@ -1,11 +1,14 @@
 #include "io/transforms.hpp"
 
+#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <optional>
+#include <set>
+#include <tuple>
 #include <utility>
 
 #include "core/error.hpp"
@@ -103,9 +106,12 @@ std::string read_file_path(const json& frame, const Where& where) {
   return path;
 }
 
+// A 3x4 matrix (nerfstudio accepts one) has the last row of a pose implied.
 bool read_4x4(const json& value, double matrix[4][4]) {
-  if (!value.is_array() || value.size() != 4) return false;
-  for (int r = 0; r < 4; ++r) {
+  if (!value.is_array() || (value.size() != 4 && value.size() != 3)) return false;
+  const double last_row[4] = {0, 0, 0, 1};
+  std::copy(last_row, last_row + 4, matrix[3]);
+  for (int r = 0; r < int(value.size()); ++r) {
     const json& row = value[r];
     if (!row.is_array() || row.size() != 4) return false;
     for (int c = 0; c < 4; ++c) {
@@ -132,7 +138,7 @@ bool is_rotation(const double m[4][4]) {
 void read_pose(const json& frame, const Where& where, Camera& camera) {
   double c2w[4][4];
   if (!read_4x4(require(frame, "transform_matrix", where), c2w))
-    where.fail("\"transform_matrix\" must be a 4x4 array of numbers");
+    where.fail("\"transform_matrix\" must be a 4x4 (or 3x4) array of numbers");
   if (!is_rotation(c2w)) where.fail("\"transform_matrix\" does not hold a rotation");
   opengl_c2w_to_opencv_w2c(c2w, camera.rotation, camera.translation);
   const Vec3& t = camera.translation;
@@ -259,20 +265,23 @@ Distortion nerfstudio_distortion(const FrameKeys& keys) {
         .fail(
             "fisheye lenses (\"is_fisheye\": true) are not supported (supported: PINHOLE, "
             "OPENCV)");
-  const bool has_coefficients = keys.find("k1") || keys.find("k2") || keys.find("p1") ||
-                                keys.find("p2") || keys.find("k3") || keys.find("k4");
-  const std::string model =
-      keys.string("camera_model").value_or(has_coefficients ? "OPENCV" : "PINHOLE");
-  if (model == "PINHOLE") return {};
-  if (model != "OPENCV")
+  const std::string model = keys.string("camera_model").value_or("PINHOLE");
+  if (model != "PINHOLE" && model != "OPENCV")
     keys.where("camera_model")
         .fail(fmt::format("unsupported \"camera_model\" {} (supported: PINHOLE, OPENCV)",
                           quoted(json(model))));
-  for (const char* key : {"k3", "k4"})
-    if (keys.number(key).value_or(0) != 0)
-      keys.where(key).fail(fmt::format("\"{}\" is not supported (OPENCV uses k1 k2 p1 p2)", key));
-  return {keys.number("k1").value_or(0), keys.number("k2").value_or(0),
-          keys.number("p1").value_or(0), keys.number("p2").value_or(0)};
+  // nerfstudio's k4 is a fourth radial term of its own, OpenCV's the first of a denominator.
+  if (keys.number("k4").value_or(0) != 0)
+    keys.where("k4").fail("\"k4\" is not supported (supported: k1 k2 k3 p1 p2)");
+  // As nerfstudio and instant-ngp, the coefficients apply whichever of the two models is named:
+  // both are perspective cameras to them.
+  Distortion d;
+  d.k1 = keys.number("k1").value_or(0);
+  d.k2 = keys.number("k2").value_or(0);
+  d.k3 = keys.number("k3").value_or(0);
+  d.p1 = keys.number("p1").value_or(0);
+  d.p2 = keys.number("p2").value_or(0);
+  return d;
 }
 
 // Cameras paired with their file_path as written, in file order.
@@ -291,6 +300,76 @@ std::vector<std::pair<std::string, Camera>> nerfstudio_cameras(
     cameras.emplace_back(std::move(file_path), std::move(camera));
   }
   return cameras;
+}
+
+// nerfstudio's split lists: the images of each split, named as frames name theirs.
+struct SplitLists {
+  std::vector<fs::path> train, test;
+  std::string test_key;  // "test_filenames", or "val_filenames" when the test list is missing
+};
+
+std::optional<std::vector<fs::path>> read_split_list(const json& document, const char* key,
+                                                     const fs::path& json_path) {
+  const json* list = find(document, key);
+  if (!list) return std::nullopt;
+  const Where top{json_path};
+  if (!list->is_array()) top.fail(fmt::format("\"{}\" must be an array of file names", key));
+  std::vector<fs::path> paths;
+  for (const json& name : *list) {
+    if (!name.is_string() || name.get_ref<const std::string&>().empty())
+      top.fail(fmt::format("\"{}\" holds {}, not a file name", key, quoted(name)));
+    paths.push_back(frame_image_path(json_path.parent_path(), name.get<std::string>(),
+                                     kImageExtensionSpellings));
+  }
+  return paths;
+}
+
+// Absent when the file lists no split. As nerfstudio, a list for test without one for training
+// is an error; the test split is nerfstudio's test list, else its val list, else empty.
+std::optional<SplitLists> read_split_lists(const json& document, const fs::path& json_path) {
+  std::optional<std::vector<fs::path>> train =
+      read_split_list(document, "train_filenames", json_path);
+  SplitLists lists;
+  lists.test_key = "test_filenames";
+  std::optional<std::vector<fs::path>> test =
+      read_split_list(document, "test_filenames", json_path);
+  if (!test) {
+    lists.test_key = "val_filenames";
+    test = read_split_list(document, "val_filenames", json_path);
+  }
+  if (!train && !test) return std::nullopt;
+  if (!train)
+    fail_file(json_path, fmt::format("\"{}\" without \"train_filenames\": the split lists must "
+                                     "name the training images too",
+                                     lists.test_key));
+  lists.train = std::move(*train);
+  if (test) lists.test = std::move(*test);
+  return lists;
+}
+
+// The frames each list names, in the frames' order; a frame in both lists is in both splits, one
+// in neither is left out, as nerfstudio does. A listed image that no frame names is an error.
+void assign_listed_splits(const std::vector<std::pair<std::string, Camera>>& cameras,
+                          const SplitLists& lists, const fs::path& json_path,
+                          std::vector<Camera>& out) {
+  for (const auto& [list, split, key] :
+       {std::tuple{&lists.train, Split::Train, std::string("train_filenames")},
+        std::tuple{&lists.test, Split::Test, lists.test_key}}) {
+    const std::set<fs::path> listed(list->begin(), list->end());
+    size_t found = 0;
+    for (const auto& [file_path, camera] : cameras) {
+      if (!listed.count(camera.image_path)) continue;
+      out.push_back(camera);
+      out.back().split = split;
+      ++found;
+    }
+    if (found == listed.size()) continue;
+    for (const fs::path& path : listed)
+      if (std::none_of(cameras.begin(), cameras.end(),
+                       [&path](const auto& c) { return c.second.image_path == path; }))
+        fail_file(json_path, fmt::format("\"{}\" names {}, which no frame's file_path does", key,
+                                         path.string()));
+  }
 }
 
 }  // namespace
@@ -320,14 +399,22 @@ Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_
                                   const SceneOptions& options,
                                   const ImageHeaderReader& read_header) {
   if (options.test_every < 1) fail("--test-every must be at least 1, got {}", options.test_every);
+  const json document = parse_object(text, json_path);
   std::vector<std::pair<std::string, Camera>> cameras =
-      nerfstudio_cameras(parse_object(text, json_path), json_path, read_header);
+      nerfstudio_cameras(document, json_path, read_header);
   // The split must not depend on the order frames happen to be listed in.
   std::stable_sort(cameras.begin(), cameras.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (const json* ply = find(document, "ply_file_path"))
+    spdlog::warn("{}: \"ply_file_path\" {} is not read: training starts from random points",
+                 json_path.string(), quoted(*ply));
   Scene scene;
   scene.format = "nerfstudio";
   scene.synthetic = false;
+  if (const std::optional<SplitLists> lists = read_split_lists(document, json_path)) {
+    assign_listed_splits(cameras, *lists, json_path, scene.cameras);
+    return scene;
+  }
   for (size_t i = 0; i < cameras.size(); ++i) {
     Camera& camera = cameras[i].second;
     camera.split = i % options.test_every == 0 ? Split::Test : Split::Train;

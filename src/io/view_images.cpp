@@ -42,7 +42,8 @@ std::string undistort_key(const std::string& source_digest, const Intrinsics& k,
                           const Distortion& d) {
   return bytes_digest(
       fmt::format("{}|{}x{}|{:.9g},{:.9g},{:.9g},{:.9g}|{:.9g},{:.9g},{:.9g},{:.9g}", source_digest,
-                  k.width, k.height, k.fx, k.fy, k.cx, k.cy, d.k1, d.k2, d.p1, d.p2));
+                  k.width, k.height, k.fx, k.fy, k.cx, k.cy, d.k1, d.k2, d.p1, d.p2) +
+      d.terms_beyond_opencv());
 }
 
 // Where a camera's size came from, for the error of an image that does not match it. A

@@ -55,7 +55,8 @@ std::string view_fingerprint(const std::string& stage, const ViewImages& images,
   if (const Distortion& d = camera.distortion; d.any()) {
     const Intrinsics& k = camera.intrinsics;
     text += fmt::format(" | lens {} {} {} {} {} {} {} {}", k.fx, k.fy, k.cx, k.cy, d.k1, d.k2, d.p1,
-                        d.p2);
+                        d.p2) +
+            d.terms_beyond_opencv();
   }
   return bytes_digest(text);
 }

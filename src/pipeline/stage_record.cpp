@@ -91,10 +91,11 @@ std::string split_digest(const ViewImages& images, Split split) {
   for (const Camera* camera : scene.split(split)) {
     const Intrinsics& k = camera->intrinsics;
     const Distortion& d = camera->distortion;
-    key += fmt::format("{} {} {}x{} {} {} {} {} | {} {} {} {} | {} | {} {} {};\n", camera->name,
-                       images.source_digest(*camera), k.width, k.height, k.fx, k.fy, k.cx, k.cy,
-                       d.k1, d.k2, d.p1, d.p2, fmt::join(camera->rotation.m, " "),
-                       camera->translation.x, camera->translation.y, camera->translation.z);
+    key +=
+        fmt::format("{} {} {}x{} {} {} {} {} | {} {} {} {}{} | {} | {} {} {};\n", camera->name,
+                    images.source_digest(*camera), k.width, k.height, k.fx, k.fy, k.cx, k.cy, d.k1,
+                    d.k2, d.p1, d.p2, d.terms_beyond_opencv(), fmt::join(camera->rotation.m, " "),
+                    camera->translation.x, camera->translation.y, camera->translation.z);
   }
   return bytes_digest(key);
 }

@@ -471,7 +471,26 @@ TEST(Colmap, UnsupportedCameraModelIsNamed) {
   write_colmap_model_text(root / "sparse/0", model);
   expect_error([&] { load_scene(root.path()); },
                {(root / "sparse/0/cameras.txt").string(), "OPENCV_FISHEYE",
-                "SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV"});
+                "SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV"});
+}
+
+TEST(Colmap, FullOpencvKeepsItsRationalTerms) {
+  TempDir root;
+  ColmapModel model = sample_model();
+  model.cameras[5] = {
+      5,
+      "FULL_OPENCV",
+      1920,
+      1080,
+      {1500.3, 1499.7, 960.2, 539.8, -0.1, 0.05, 0.001, -0.002, 0.01, 0.2, -0.03, 0.004}};
+  write_colmap_model_text(root / "sparse/0", model);
+  const Distortion d = camera_named(read_colmap_scene(root.path(), {}), "frame_d").distortion;
+  EXPECT_EQ(d.k1, -0.1);
+  EXPECT_EQ(d.p2, -0.002);
+  EXPECT_EQ(d.k3, 0.01);
+  EXPECT_EQ(d.k4, 0.2);
+  EXPECT_EQ(d.k5, -0.03);
+  EXPECT_EQ(d.k6, 0.004);
 }
 
 TEST(Colmap, UnusedCameraOfAnyModelIsIgnored) {

@@ -63,6 +63,20 @@ TEST(Scene, TwoViewsOfASplitWithOneNameAreRefused) {
   EXPECT_TRUE(contains(message, "test/r_0.png")) << message;
 }
 
+// Read as a nerfstudio file, a split file would give a split of its own views.
+TEST(Scene, ASplitFileOfANerfSyntheticSceneNamesItsFolder) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 3, 1});
+  for (const char* file : {"transforms_train.json", "transforms_test.json"}) {
+    const std::string message = error_message([&] { load_scene(dir / "scene" / file); });
+    EXPECT_TRUE(contains(message, std::string(file) +
+                                      ": one split of a NeRF Synthetic scene: give the scene's "
+                                      "folder, " +
+                                      (dir / "scene").string()))
+        << message;
+  }
+}
+
 TEST(Scene, ViewsOfDifferentSplitsMayShareAName) {
   TempDir dir;
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 2});

@@ -187,6 +187,49 @@ TEST(NerfstudioScene, SortsFramesByFilePathAndHoldsOutEveryKth) {
   EXPECT_EQ(scene.cameras[0].image_path, fs::path("/data/images/a.jpg"));
 }
 
+// The camera names and splits of a scene, in order: "a-" for a training view a, "bT" for a test
+// view b.
+std::string names_and_splits(const Scene& scene) {
+  std::string out;
+  for (const Camera& camera : scene.cameras)
+    out += camera.name + (camera.split == Split::Test ? "T" : "-");
+  return out;
+}
+
+TEST(NerfstudioScene, SplitListsSetTheSplitAsNerfstudio) {
+  json document = nerfstudio_document();
+  document["frames"] = json::array();
+  for (const char* name : {"e", "c", "a", "d", "b"})
+    document["frames"].push_back(frame(std::string("images/") + name + ".jpg"));
+  // Names resolve as file_path does: "./images/c.jpg" is "images/c.jpg".
+  document["train_filenames"] = {"images/a.jpg", "./images/c.jpg", "images/e.jpg"};
+  document["val_filenames"] = {"images/b.jpg"};
+  EXPECT_EQ(names_and_splits(parse_in_memory(document)), "a-c-e-bT");  // d is in neither
+  document["test_filenames"] = {"images/d.jpg", "images/a.jpg"};
+  EXPECT_EQ(names_and_splits(parse_in_memory(document)), "a-c-e-aTdT");
+
+  document["test_filenames"] = {"images/f.jpg"};
+  EXPECT_NE(error_message([&] {
+              parse_in_memory(document);
+            }).find("\"test_filenames\" names /data/images/f.jpg, which no frame's file_path does"),
+            std::string::npos);
+  document.erase("train_filenames");
+  EXPECT_NE(error_message([&] {
+              parse_in_memory(document);
+            }).find("\"test_filenames\" without \"train_filenames\""),
+            std::string::npos);
+}
+
+TEST(NerfstudioScene, ThreeRowMatrixIsAPose) {
+  json document = nerfstudio_document();
+  const Camera four = parse_in_memory(document).cameras[0];
+  document["frames"][0]["transform_matrix"].erase(3);
+  document["frames"][1]["transform_matrix"].erase(3);
+  const Camera three = parse_in_memory(document).cameras[0];
+  EXPECT_EQ(three.rotation.m, four.rotation.m);
+  EXPECT_EQ(three.translation.z, four.translation.z);
+}
+
 TEST(NerfstudioScene, FrameKeysOverrideSceneIntrinsics) {
   json document = nerfstudio_document();
   document["fl_y"] = 12.0;
@@ -247,20 +290,23 @@ TEST(NerfstudioScene, CameraModels) {
   json document = nerfstudio_document();
   EXPECT_FALSE(parse_in_memory(document).cameras[0].distortion.any());
 
-  document["k1"] = 0.1;  // no camera_model with coefficients: OPENCV
+  document["k1"] = 0.1;  // instant-ngp names no camera model
   document["p2"] = -0.01;
   document["is_fisheye"] = false;  // as instant-ngp's colmap2nerf writes it
   Distortion d = parse_in_memory(document).cameras[0].distortion;
   EXPECT_DOUBLE_EQ(d.k1, 0.1);
   EXPECT_DOUBLE_EQ(d.k2, 0);
   EXPECT_DOUBLE_EQ(d.p2, -0.01);
+  EXPECT_FALSE(d.beyond_opencv());
 
+  // As nerfstudio: the coefficients apply under either model's name, k3 included.
   document["camera_model"] = "PINHOLE";
-  EXPECT_FALSE(parse_in_memory(document).cameras[0].distortion.any());
-
+  document["k3"] = 0.02;
+  d = parse_in_memory(document).cameras[0].distortion;
+  EXPECT_DOUBLE_EQ(d.k1, 0.1);
+  EXPECT_DOUBLE_EQ(d.k3, 0.02);
   document["camera_model"] = "OPENCV";
-  document["k3"] = 0;  // zero k3 changes nothing
-  EXPECT_DOUBLE_EQ(parse_in_memory(document).cameras[0].distortion.k1, 0.1);
+  EXPECT_DOUBLE_EQ(parse_in_memory(document).cameras[0].distortion.k3, 0.02);
 }
 
 TEST(NerfstudioScene, MissingImageIsAnError) {
@@ -318,12 +364,18 @@ TEST(NerfstudioScene, BadInputGivesOneLineErrorNamingFileAndProblem) {
       {"no matrix",
        edited([](json& d) { d["frames"][1].erase("transform_matrix"); }),
        {"frame 1: missing \"transform_matrix\""}},
-      {"3x4 matrix",
-       edited([](json& d) { d["frames"][1]["transform_matrix"].erase(3); }),
-       {"frame 1: \"transform_matrix\" must be a 4x4 array of numbers"}},
+      {"2x4 matrix",
+       edited([](json& d) {
+         d["frames"][1]["transform_matrix"].erase(3);
+         d["frames"][1]["transform_matrix"].erase(2);
+       }),
+       {"frame 1: \"transform_matrix\" must be a 4x4 (or 3x4) array of numbers"}},
       {"string entry",
        edited([](json& d) { d["frames"][0]["transform_matrix"][2][1] = "0"; }),
-       {"frame 0: \"transform_matrix\" must be a 4x4 array of numbers"}},
+       {"frame 0: \"transform_matrix\" must be a 4x4 (or 3x4) array of numbers"}},
+      {"split list not a list",
+       edited([](json& d) { d["train_filenames"] = "images/a.png"; }),
+       {"\"train_filenames\" must be an array of file names"}},
       {"huge entry",
        edited([](json& d) { d["frames"][0]["transform_matrix"][0][0] = 1e300; }),
        {"frame 0: \"transform_matrix\" does not hold a rotation"}},
@@ -374,7 +426,7 @@ TEST(NerfstudioScene, BadInputGivesOneLineErrorNamingFileAndProblem) {
       {"model not string",
        edited([](json& d) { d["frames"][0]["camera_model"] = 1; }),
        {"frame 0: \"camera_model\" must be a string"}},
-      {"k3", edited([](json& d) { d["k3"] = 0.01; }), {"\"k3\" is not supported"}},
+      {"k4", edited([](json& d) { d["k4"] = 0.01; }), {"\"k4\" is not supported"}},
       {"focal beyond float",
        edited([](json& d) { d["fl_x"] = 1e300; }),
        {"\"fl_x\" 1e+300 is beyond the single-precision range"}},

@@ -63,8 +63,8 @@ bool sampled_inside(const Intrinsics& k, const Distortion& d, int u, int v) {
 
 TEST(Undistort, DistortedPatternBecomesThePinholePattern) {
   const Intrinsics k{160, 120, 100, 95, 81.3, 58.7};
-  for (const Distortion& d :
-       {Distortion{-0.25, 0.05, 0.004, -0.003}, Distortion{0.3, -0.1, 0, 0}}) {
+  for (const Distortion& d : {Distortion{-0.25, 0.05, 0.004, -0.003}, Distortion{0.3, -0.1, 0, 0},
+                              Distortion{-0.2, 0.03, 0.002, -0.001, 0.02, 0.1, -0.02, 0.01}}) {
     SCOPED_TRACE(d.k1);
     const Image8 pinhole = render_pattern(k, {});
     const Image8 distorted = render_pattern(k, d);
