@@ -41,7 +41,9 @@ void check(const std::vector<Camera>& cameras) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
-    check(iesrgs::parse_nerfstudio_transforms(text, "scene/transforms.json", {}, fake_header)
+    check(iesrgs::parse_nerfstudio_transforms(
+              text, "scene/transforms.json", {}, fake_header,
+              [](const std::filesystem::path&) { return iesrgs::PointCloud{}; })
               .cameras);
   } catch (const iesrgs::Error&) {
   }

@@ -445,6 +445,50 @@ void read_body(Values values, const Header& header, const std::vector<const Slot
     }
 }
 
+// ---- point clouds ----
+
+constexpr const char* kPointProperties[6] = {"x", "y", "z", "red", "green", "blue"};
+
+// Where each of kPointProperties sits among the vertex properties.
+std::array<size_t, 6> point_property_indices(const Header& header, const fs::path& name) {
+  std::array<size_t, 6> index{};
+  for (size_t k = 0; k < index.size(); ++k) {
+    const auto it = std::find_if(header.properties.begin(), header.properties.end(),
+                                 [&](const Property& p) { return p.name == kPointProperties[k]; });
+    if (it == header.properties.end())
+      fail_file(name, fmt::format("missing property '{}' (a point cloud has x y z red green blue)",
+                                  kPointProperties[k]));
+    index[k] = size_t(it - header.properties.begin());
+  }
+  return index;
+}
+
+// fmin / fmax also map NaN to a byte.
+uint8_t color_byte(double value, Scalar type) {
+  const bool unit = type == Scalar::kFloat32 || type == Scalar::kFloat64;
+  return uint8_t(std::lround(std::fmin(std::fmax(unit ? value * 255 : value, 0.0), 255.0)));
+}
+
+template <typename Values>
+PointCloud read_points(Values values, const Header& header, const fs::path& name) {
+  const std::array<size_t, 6> index = point_property_indices(header, name);
+  PointCloud points;
+  points.positions.resize(header.vertex_count);
+  points.colors.resize(header.vertex_count);
+  std::vector<double> row(header.properties.size());
+  for (size_t i = 0; i < header.vertex_count; ++i) {
+    for (size_t p = 0; p < row.size(); ++p) row[p] = values.next(i, header.properties[p]);
+    for (size_t k = 0; k < 3; ++k)
+      if (!(std::fabs(row[index[k]]) <= FLT_MAX))
+        fail_file(name, fmt::format("vertex {}: property '{}' is not a finite float ({})", i,
+                                    kPointProperties[k], row[index[k]]));
+    points.positions[i] = {row[index[0]], row[index[1]], row[index[2]]};
+    for (size_t c = 0; c < 3; ++c)
+      points.colors[i][c] = color_byte(row[index[3 + c]], header.properties[index[3 + c]].type);
+  }
+  return points;
+}
+
 }  // namespace
 
 void write_ply(const fs::path& path, const SplatCloud& cloud) {
@@ -505,6 +549,19 @@ SplatCloud parse_ply(std::string_view bytes, const fs::path& name) {
   cloud.antialiased = has_filter;
   cloud.background = header.background;
   return cloud;
+}
+
+PointCloud read_point_ply(const fs::path& path) {
+  return parse_point_ply(read_file(path), path);
+}
+
+PointCloud parse_point_ply(std::string_view bytes, const fs::path& name) {
+  const Header header = HeaderParser(bytes, name).parse();
+  point_property_indices(header, name);  // before check_count_fits, which needs properties
+  const std::string_view body = bytes.substr(header.body_offset);
+  check_count_fits(header, body.size(), name);
+  if (header.ascii) return read_points(AsciiValues(body, name), header, name);
+  return read_points(BinaryValues(body), header, name);
 }
 
 }  // namespace iesrgs

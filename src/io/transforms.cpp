@@ -1,6 +1,5 @@
 #include "io/transforms.hpp"
 
-#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -15,6 +14,7 @@
 #include "core/paths.hpp"
 #include "io/atomic_file.hpp"
 #include "io/json_file.hpp"
+#include "io/ply.hpp"
 
 namespace iesrgs {
 
@@ -396,8 +396,8 @@ std::vector<Camera> parse_blender_transforms(const std::string& text, const fs::
 }
 
 Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_path,
-                                  const SceneOptions& options,
-                                  const ImageHeaderReader& read_header) {
+                                  const SceneOptions& options, const ImageHeaderReader& read_header,
+                                  const PointFileReader& read_points) {
   if (options.test_every < 1) fail("--test-every must be at least 1, got {}", options.test_every);
   const json document = parse_object(text, json_path);
   std::vector<std::pair<std::string, Camera>> cameras =
@@ -405,12 +405,15 @@ Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_
   // The split must not depend on the order frames happen to be listed in.
   std::stable_sort(cameras.begin(), cameras.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
-  if (const json* ply = find(document, "ply_file_path"))
-    spdlog::warn("{}: \"ply_file_path\" {} is not read: training starts from random points",
-                 json_path.string(), quoted(*ply));
   Scene scene;
   scene.format = "nerfstudio";
   scene.synthetic = false;
+  if (const json* ply = find(document, "ply_file_path")) {
+    if (!ply->is_string() || ply->get_ref<const std::string&>().empty())
+      fail_file(json_path, "\"ply_file_path\" must be a file name");
+    scene.points =
+        read_points((json_path.parent_path() / ply->get<std::string>()).lexically_normal());
+  }
   if (const std::optional<SplitLists> lists = read_split_lists(document, json_path)) {
     assign_listed_splits(cameras, *lists, json_path, scene.cameras);
     return scene;
@@ -445,7 +448,7 @@ Scene read_blender_scene(const fs::path& root, const SceneOptions&) {
 
 Scene read_nerfstudio_scene(const fs::path& transforms_json, const SceneOptions& options) {
   Scene scene = parse_nerfstudio_transforms(read_file(transforms_json), transforms_json, options,
-                                            read_image_header);
+                                            read_image_header, read_point_ply);
   require_images_exist(scene.cameras, transforms_json);
   return scene;
 }

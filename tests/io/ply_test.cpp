@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -200,6 +201,53 @@ TEST(Ply, ReadsHandWrittenAsciiInAnyOrderAndType) {
   EXPECT_EQ(cloud.sh_dc, (std::vector<float>{0.1f, 0.2f, 0.3f, 1, 2, 3}));
   EXPECT_EQ(cloud.rotations, (std::vector<float>{1, 0, 0, 0, 0.7071f, 0.7071f, 0, 0}));
   EXPECT_TRUE(cloud.sh_rest.empty());
+}
+
+TEST(Ply, PointCloudsAsOpen3dAndColmapWriteThem) {
+  // Binary, double positions, float colours in [0, 1], normals and an alpha among them.
+  std::string bytes =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty double x\n"
+      "property double y\nproperty double z\nproperty float nx\nproperty float red\n"
+      "property float green\nproperty float blue\nproperty uchar alpha\nend_header\n";
+  const auto put = [&bytes](auto value) {
+    bytes.append(reinterpret_cast<const char*>(&value), sizeof(value));
+  };
+  for (const double position : {1.5, -2.0, 1e-3}) put(position);
+  for (const float value : {0.0f, 1.0f, 0.5f, 2.0f}) put(value);  // nx, colours (2 clamps)
+  put(uint8_t(7));
+  for (const double position : {4.0, 5.0, 6.0}) put(position);
+  for (const float value : {0.0f, 0.0f, -1.0f, std::nanf("")}) put(value);
+  put(uint8_t(7));
+  const PointCloud points = parse_point_ply(bytes, "points.ply");
+  ASSERT_EQ(points.positions.size(), 2u);
+  EXPECT_EQ(points.positions[0].x, 1.5);
+  EXPECT_EQ(points.positions[0].z, 1e-3);
+  EXPECT_EQ(points.positions[1].y, 5.0);
+  EXPECT_EQ(points.colors[0], (std::array<uint8_t, 3>{255, 128, 255}));
+  EXPECT_EQ(points.colors[1], (std::array<uint8_t, 3>{0, 0, 0}));
+
+  // A Gaussian splatting model has no red: it is not a point cloud.
+  const std::string model =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+      "property float y\nproperty float z\nproperty float f_dc_0\n"
+      "end_header\n1 2 3 0.5\n";
+  EXPECT_NE(error_message([&] {
+              parse_point_ply(model, "model.ply");
+            }).find("model.ply: missing property 'red' (a point cloud has x y z red green blue)"),
+            std::string::npos);
+  const std::string infinite =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+      "property float y\nproperty double z\nproperty uchar red\n"
+      "property uchar green\nproperty uchar blue\nend_header\n"
+      "1 2 1e300 0 0 0\n";
+  EXPECT_NE(error_message([&] {
+              parse_point_ply(infinite, "far.ply");
+            }).find("far.ply: vertex 0: property 'z' is not a finite float"),
+            std::string::npos);
+  EXPECT_NE(error_message([&] {
+              parse_point_ply(infinite.substr(0, infinite.size() - 4), "cut");
+            }).find("cut: truncated"),
+            std::string::npos);
 }
 
 // A valid binary file with `from` replaced by `to` (which must occur in it).

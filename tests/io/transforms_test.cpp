@@ -53,10 +53,17 @@ fs::path write_nerfstudio_scene(const TempDir& dir, const json& document) {
 }
 
 Scene parse_in_memory(const json& document, const SceneOptions& options = {}) {
-  return parse_nerfstudio_transforms(document.dump(), "/data/transforms.json", options,
-                                     [](const fs::path&) {
-                                       return ImageHeader{64, 48, 3};
-                                     });
+  return parse_nerfstudio_transforms(
+      document.dump(), "/data/transforms.json", options,
+      [](const fs::path&) {
+        return ImageHeader{64, 48, 3};
+      },
+      [](const fs::path& path) {
+        PointCloud points;  // one point, whose colour says which file was asked for
+        points.positions.push_back({1, 2, 3});
+        points.colors.push_back({uint8_t(path.string().size()), 0, 0});
+        return points;
+      });
 }
 
 TEST(BlenderScene, ReadsNerfSyntheticLego) {
@@ -218,6 +225,26 @@ TEST(NerfstudioScene, SplitListsSetTheSplitAsNerfstudio) {
               parse_in_memory(document);
             }).find("\"test_filenames\" without \"train_filenames\""),
             std::string::npos);
+}
+
+TEST(NerfstudioScene, PlyFilePathGivesThePoints) {
+  json document = nerfstudio_document();
+  EXPECT_TRUE(parse_in_memory(document).points.positions.empty());
+  document["ply_file_path"] = "./sparse_pc.ply";  // "/data/sparse_pc.ply", 19 characters
+  const PointCloud points = parse_in_memory(document).points;
+  ASSERT_EQ(points.positions.size(), 1u);
+  EXPECT_EQ(points.colors[0][0], 19);
+
+  // Read from a file: an ascii cloud as nerfstudio's ns-process-data writes it.
+  TempDir dir;
+  write_text(dir / "sparse_pc.ply",
+             "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+             "property float z\nproperty uint8 red\nproperty uint8 green\nproperty uint8 blue\n"
+             "end_header\n0.5 -1 2 255 128 0\n3 4 5 1 2 3\n");
+  const Scene scene = read_nerfstudio_scene(write_nerfstudio_scene(dir, document), {});
+  ASSERT_EQ(scene.points.positions.size(), 2u);
+  EXPECT_EQ(scene.points.positions[0].y, -1);
+  EXPECT_EQ(scene.points.colors[0], (std::array<uint8_t, 3>{255, 128, 0}));
 }
 
 TEST(NerfstudioScene, ThreeRowMatrixIsAPose) {
