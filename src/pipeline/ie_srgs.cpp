@@ -118,6 +118,8 @@ class Pipeline {
   // Whether the earlier table's `entry` for `row` is what these settings would give.
   bool row_current(const RowSpec& row, const nlohmann::json& entry, bool internal_current) const;
   bool row_model_cached(const RowSpec& row) const;  // its HR model is trained for these settings
+  // What this run scores against: the test views' digest and the LPIPS net.
+  nlohmann::json evaluation() const;
   void keep_earlier_rows(RunResult& result) const;
   void write_fusion_diagnostics(const gs::GaussianModel& model, const FusionSetup& setup) const;
   void write_mask_agreement(const FusionSetup& setup) const;
@@ -242,10 +244,11 @@ void Pipeline::check_cached_inputs() const {
             o_.output / "internal", "internal", "iesrgs internal or iesrgs run");
 }
 
-// An interrupted run leaves no table or test renders of an earlier one that read as its own: the
-// table is written again when the run finishes, each row's test views when the row is scored.
-// `iesrgs internal` scores nothing, so it does this only when it makes the internal model again,
-// whose row's renders then show a model that is gone. results.json stays, for keep_earlier_rows.
+// An interrupted run leaves no table, row scores or test renders of an earlier one that read as
+// its own: the table is written again when the run finishes, each row's scores and test views
+// when the row is scored. `iesrgs internal` scores nothing, so it does this only when it makes
+// the internal model again, whose row's scores and renders then show a model that is gone. The
+// other rows' scores stay, for keep_earlier_rows.
 void Pipeline::forget_earlier_results() const {
   const bool scoring = o_.only != StageSelection::Internal;
   // The model alone: the check of the SR-splatting renders decodes every one of them, which
@@ -254,11 +257,15 @@ void Pipeline::forget_earlier_results() const {
       (!scoring || rows_use_internal_references()) &&
       !internal_model_current(lr_scene_, train_digest_, o_.internal_config, o_.output / "internal");
   if (!scoring && !internal_changes) return;
-  for (const char* table : {"results.md", "results.csv"})
+  for (const char* table : {"results.md", "results.csv", "results.json"})
     remove_earlier_output(o_.output / table, "left by an earlier run");
-  if (internal_changes) mark_render_stale(o_.output / "rows" / "internal" / "test");
+  const auto forget_row = [this](const std::string& id) {
+    remove_earlier_output(o_.output / "rows" / id / kRowResultFile, "left by an earlier run");
+    mark_render_stale(o_.output / "rows" / id / "test");
+  };
+  if (internal_changes) forget_row("internal");
   if (scoring)
-    for (const std::string& id : rows_) mark_render_stale(o_.output / "rows" / id / "test");
+    for (const std::string& id : rows_) forget_row(id);
 }
 
 // The stages' time is what computing their views took when it ran, as a reused training counts
@@ -538,20 +545,18 @@ RunResult Pipeline::run() {
   for (size_t i = 0; i < rows_.size(); ++i) {
     const RowSpec& row = row_spec(rows_[i]);
     fmt::print("\n== row {}/{} {}: {} ==\n", i + 1, rows_.size(), row.id, row_label(row));
+    const fs::path dir = o_.output / "rows" / row.id;
     if (row.source != Source::Internal) {
       const Stopwatch row_watch;
       result.rows.push_back(run_fusion_row(row));
       progress.row_done(row_watch.seconds());
-      continue;
+    } else {
+      result.rows.push_back(evaluate_row(row, internal_->training.model, dir));
+      result.rows.back().train_seconds = internal_->training.seconds;
     }
-    RowResult internal = evaluate_row(row, internal_->training.model, o_.output / "rows" / row.id);
-    internal.train_seconds = internal_->training.seconds;
-    result.rows.push_back(internal);
+    write_row_result(dir, result.rows.back(), evaluation());
   }
-  // "lpips" is the net asked for, which earlier rows are matched by; the status says whether it
-  // was computed.
-  result.evaluation = {{"test_views", test_digest_}, {"lpips", o_.lpips}};
-  if (lpips_) result.evaluation["lpips_status"] = lpips_->status;
+  result.evaluation = evaluation();
   keep_earlier_rows(result);
   stages_["total_seconds_this_run"] = watch.seconds();
   result.stages = stages_;
@@ -576,31 +581,39 @@ bool Pipeline::row_model_cached(const RowSpec& row) const {
                                 o_.fusion_config);
 }
 
-// A rerun with fewer rows keeps the others of the folder's table, as long as their cached stage
-// is still the one these settings would reuse and they were scored against the same test views;
-// rows trained under other settings are dropped, and so are entries a damaged results.json
-// garbled. An LPIPS taken with another network is left out.
+nlohmann::json Pipeline::evaluation() const {
+  // "lpips" is the net asked for, which earlier rows are matched by; the status says whether it
+  // was computed.
+  nlohmann::json evaluation = {{"test_views", test_digest_}, {"lpips", o_.lpips}};
+  if (lpips_) evaluation["lpips_status"] = lpips_->status;
+  return evaluation;
+}
+
+// A rerun with fewer rows keeps the other rows scored in this folder, whichever run scored them,
+// as long as their cached stage is still the one these settings would reuse and they were scored
+// against the same test views; rows trained under other settings are left out, and so are scores
+// a damaged file garbled. An LPIPS taken with another network is left out.
 void Pipeline::keep_earlier_rows(RunResult& result) const {
-  const nlohmann::json earlier = read_stage_record(o_.output / "results.json");
-  const nlohmann::json scored = earlier.value("evaluation", nlohmann::json());
-  const auto same = [&](const char* key) {
-    return scored.is_object() && scored.value(key, nlohmann::json()) == result.evaluation[key];
-  };
-  if (!same("test_views")) return;
-  const bool same_lpips = same("lpips");
-  // Asked once: the check decodes every cached render. A stage this run used is current.
-  const bool internal_current =
-      internal_.has_value() || internal_stage_current(lr_scene_, train_digest_, o_.internal_config,
-                                                      o_.scale, o_.output / "internal");
-  const nlohmann::json rows = earlier.value("rows", nlohmann::json::array());
-  for (const nlohmann::json& entry : rows.is_array() ? rows : nlohmann::json::array()) {
+  // Asked at most once: the check decodes every cached render. A stage this run used is current.
+  std::optional<bool> internal_current;
+  if (internal_) internal_current = true;
+  for (const std::string& id : expand_rows({"all"})) {
+    if (std::find(rows_.begin(), rows_.end(), id) != rows_.end()) continue;
+    const nlohmann::json earlier = read_stage_record(o_.output / "rows" / id / kRowResultFile);
+    const nlohmann::json scored = earlier.value("evaluation", nlohmann::json());
+    const auto same = [&](const char* key) {
+      return scored.is_object() && scored.value(key, nlohmann::json()) == result.evaluation[key];
+    };
+    if (!same("test_views")) continue;
     try {
-      const RowSpec* row = find_row(entry.at("row").get<std::string>());
-      if (!row || std::find(rows_.begin(), rows_.end(), row->id) != rows_.end() ||
-          !row_current(*row, entry, internal_current))
-        continue;
-      result.rows.push_back(earlier_row(*row, row_label(*row), entry));
-      if (!same_lpips) result.rows.back().mean.lpips.reset();
+      const nlohmann::json& entry = earlier.at("row");
+      const RowSpec& row = row_spec(id);
+      if (!internal_current)
+        internal_current = internal_stage_current(lr_scene_, train_digest_, o_.internal_config,
+                                                  o_.scale, o_.output / "internal");
+      if (entry.at("row") != id || !row_current(row, entry, *internal_current)) continue;
+      result.rows.push_back(earlier_row(row, row_label(row), entry));
+      if (!same("lpips")) result.rows.back().mean.lpips.reset();
     } catch (const nlohmann::json::exception&) {
       continue;
     }

@@ -56,6 +56,12 @@ std::string stages_markdown(const RunResult& result) {
 
 }  // namespace
 
+void write_row_result(const std::filesystem::path& row_dir, const RowResult& row,
+                      const nlohmann::json& evaluation) {
+  const nlohmann::json record = {{"evaluation", evaluation}, {"row", row_json(row)}};
+  write_file_atomically(row_dir / kRowResultFile, record.dump(2) + "\n");
+}
+
 RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry) {
   RowResult row;
   row.id = spec.id;

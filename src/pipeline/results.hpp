@@ -26,8 +26,16 @@ struct RunResult {
   nlohmann::json stages;      // seconds per stage
   nlohmann::json evaluation;  // what the rows were scored against: test views' digest, LPIPS net
 };
-// A row of an earlier results.json, which names it; kept only under the current settings, so its
-// label is the one they give.
+// Where a scored row keeps its entry of the table and what it was scored against, in its folder:
+// a later run with other rows finds it there.
+inline constexpr char kRowResultFile[] = "result.json";
+
+// Writes <row_dir>/result.json atomically: {"evaluation": evaluation, "row": the row's entry}.
+void write_row_result(const std::filesystem::path& row_dir, const RowResult& row,
+                      const nlohmann::json& evaluation);
+
+// The row of an earlier run's entry; kept only under the current settings, so its label is the
+// one they give.
 RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry);
 
 // The table as Markdown, then the time per stage; rows without ground truth show "-".

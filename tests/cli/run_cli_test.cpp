@@ -176,10 +176,12 @@ TEST_F(RunCli, RunsEveryStageAndRowThenReusesThem) {
   const Table independent = {{"bicubic", true}, {"external", false}, {"hr", true}};
   EXPECT_EQ(table(), independent);
 
-  // A damaged table costs only the rows it garbled.
-  write_file_atomically(
-      dir / "run" / "results.json",
-      R"({"rows": [{"row": 5}, "x", {"row": "hr", "psnr": "bad", "ssim": 0.9}]})");
+  // A damaged score costs only its row.
+  const auto hr_result = dir / "run" / "rows" / "hr" / "result.json";
+  auto hr = nlohmann::json::parse(read_file(hr_result));
+  hr["row"]["psnr"] = "bad";
+  write_file_atomically(hr_result, hr.dump());
+  write_file_atomically(dir / "run" / "rows" / "bicubic" / "result.json", "{\"evaluation\": ");
   const CliRun damaged = iesrgs(external_only + " --internal-set seed=7");
   ASSERT_EQ(damaged.status, 0) << damaged.output;
   EXPECT_EQ(table(), (Table{{"external", false}}));
@@ -301,9 +303,10 @@ TEST_F(RunCli, AStoppedRerunLeavesNothingOfTheEarlierRunThatReadsAsItsOwn) {
   ASSERT_EQ(stopped.status, 1) << stopped.output;
   EXPECT_FALSE(std::filesystem::exists(run / "results.md"));
   EXPECT_FALSE(std::filesystem::exists(run / "results.csv"));
-  EXPECT_TRUE(std::filesystem::exists(run / "results.json"));  // the rows a rerun may keep
+  EXPECT_FALSE(std::filesystem::exists(run / "results.json"));
   for (const char* row : {"internal", "external"}) {
     EXPECT_FALSE(finished(row)) << row;
+    EXPECT_FALSE(std::filesystem::exists(run / "rows" / row / "result.json")) << row;
     EXPECT_FALSE(std::filesystem::exists(run / "rows" / row / "test" / "metrics.json")) << row;
   }
   EXPECT_TRUE(contains(iesrgs("info " + out).output, "no results.md yet"));
@@ -428,15 +431,32 @@ TEST_F(RunCli, RetrainedInternalModelDropsTheEarlierInternalRow) {
 TEST_F(RunCli, AnEarlierRowIsKeptOnlyForTheModelItScored) {
   ASSERT_EQ(write_scene(32, 4, 1), 0);
   ASSERT_EQ(run_rows("bicubic,external").status, 0);
-  const auto results_path = dir / "run" / "results.json";
-  auto results = nlohmann::json::parse(read_file(results_path));
-  ASSERT_EQ(results["rows"][1]["row"], "external");
-  results["rows"][1]["train_seconds"] = results["rows"][1]["train_seconds"].get<double>() + 1;
-  write_file_atomically(results_path, results.dump());
+  const auto scored_path = dir / "run" / "rows" / "external" / "result.json";
+  auto scored = nlohmann::json::parse(read_file(scored_path));
+  scored["row"]["train_seconds"] = scored["row"]["train_seconds"].get<double>() + 1;
+  write_file_atomically(scored_path, scored.dump());
   ASSERT_EQ(run_rows("bicubic").status, 0);
-  results = nlohmann::json::parse(read_file(results_path));
+  const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
   ASSERT_EQ(results["rows"].size(), 1u) << results.dump();
   EXPECT_EQ(results["rows"][0]["row"], "bicubic");
+}
+
+// A row scored under these settings is kept even when a run under other settings came between:
+// the table of that run left it out, its own folder kept its scores.
+TEST_F(RunCli, ARowComesBackWithTheSettingsItWasScoredUnder) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
+  ASSERT_EQ(run_rows("external,ie-srgs", " --threshold 0.3").status, 0);
+  const auto rows = [&] {
+    const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+    std::vector<std::string> ids;
+    for (const auto& row : results["rows"]) ids.push_back(row["row"]);
+    return ids;
+  };
+  ASSERT_EQ(run_rows("external").status, 0);  // T = 0.6: ie-srgs is not this setting's
+  EXPECT_EQ(rows(), std::vector<std::string>{"external"});
+  const CliRun back = run_rows("external", " --threshold 0.3");
+  ASSERT_EQ(back.status, 0) << back.output;
+  EXPECT_EQ(rows(), (std::vector<std::string>{"external", "ie-srgs"}));
 }
 
 // The oracle mask comes from the HR truth: an edited HR view trains the row again, though the LR
