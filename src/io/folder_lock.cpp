@@ -16,7 +16,31 @@ namespace iesrgs {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// A folder inside one that another process holds (a run's stage folders, say) is that process's
+// to write: a `train` or `render` there would change what the run has cached under it.
+void refuse_inside_held_folder(const fs::path& folder) {
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(folder, ec);
+  if (ec) return;
+  for (fs::path above = absolute.parent_path(); above.has_relative_path();
+       above = above.parent_path()) {
+    const int fd = ::open(above.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) continue;
+    const bool held = ::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+    ::close(fd);
+    if (held)
+      fail_file(folder, "inside " + above.string() +
+                            ", which another iesrgs process is writing; wait for it to end (or "
+                            "stop it) first");
+  }
+}
+
+}  // namespace
+
 FolderLock::FolderLock(const fs::path& folder) {
+  refuse_inside_held_folder(folder);
   std::error_code ec;
   for (fs::path missing = folder; !missing.empty() && !fs::exists(missing, ec);
        missing = missing.parent_path())

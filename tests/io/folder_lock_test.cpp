@@ -27,6 +27,20 @@ TEST(FolderLock, OneHolderAtATime) {
   EXPECT_TRUE(std::filesystem::is_empty(folder));  // no lock file among the outputs
 }
 
+TEST(FolderLock, AFolderInsideAHeldOneIsRefused) {
+  TempDir dir;
+  std::optional<FolderLock> run(dir / "run");
+  const auto stage = dir / "run" / "internal";
+  const std::string message = error_message([&] { FolderLock train(stage); });
+  EXPECT_TRUE(contains(message, stage.string() + ": inside " + (dir / "run").string() +
+                                    ", which another iesrgs process is writing"))
+      << message;
+  EXPECT_FALSE(std::filesystem::exists(stage));
+  run.reset();
+  FolderLock train(stage);
+  FolderLock beside(dir / "other");  // held folders lock only what is inside them
+}
+
 TEST(FolderLock, FoldersItCreatedAndLeftEmptyAreRemoved) {
   TempDir dir;
   { FolderLock unused(dir / "new" / "run"); }
