@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/progress.hpp"
 #include "core/stopwatch.hpp"
 #include "io/atomic_file.hpp"
@@ -110,6 +111,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
       if (recorded.is_number()) view.seconds = recorded.get<double>();
       continue;
     }
+    stop_if_interrupted("the external stage");
     if (!loaded) {
       sr = priors::sr::make_sr_net(options.sr_model, options.sr_weights, options.scale);
       depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights);

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/math.hpp"
 #include "core/paths.hpp"
 #include "core/progress.hpp"
@@ -626,6 +627,8 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
 }  // namespace
 
 RunResult run_ie_srgs(const RunOptions& options) {
+  // Between views and iterations, every stage stops where a rerun resumes.
+  const InterruptScope interrupts;
   Pipeline pipeline(options);
   // Taken once the scenes have loaded, so that a run refused for its input leaves no folder.
   const FolderLock lock(options.output);

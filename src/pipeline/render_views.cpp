@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/memory.hpp"
 #include "core/stopwatch.hpp"
 #include "io/atomic_file.hpp"
@@ -142,6 +143,7 @@ double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel
   if (!cameras.empty()) render_view(model, cameras.front().scaled(scale), background);
   double render_seconds = 0;
   for (size_t i = 0; i < cameras.size(); ++i) {
+    stop_if_interrupted("rendering");
     const Camera camera = cameras[i].scaled(scale);
     const Stopwatch watch;
     const RenderedView view = render_view(model, camera, background);

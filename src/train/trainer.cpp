@@ -7,15 +7,14 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <csignal>
 #include <limits>
 #include <numeric>
 #include <sstream>
 
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/memory.hpp"
 #include "core/torch_error.hpp"
 #include "eval/metrics.hpp"
@@ -30,32 +29,6 @@
 namespace iesrgs::train {
 
 namespace {
-
-std::atomic<bool> interrupt_requested{false};
-
-extern "C" void request_interrupt(int signal) {
-  interrupt_requested = true;
-  std::signal(signal, SIG_DFL);  // a second Ctrl-C stops at once
-}
-
-// SIGINT (Ctrl-C) and SIGTERM (kill, timeout, docker stop) ask the loop to checkpoint and
-// return, only while a run is in progress.
-class InterruptScope {
- public:
-  InterruptScope() {
-    interrupt_requested = false;
-    previous_int_ = std::signal(SIGINT, request_interrupt);
-    previous_term_ = std::signal(SIGTERM, request_interrupt);
-  }
-  ~InterruptScope() {
-    std::signal(SIGINT, previous_int_);
-    std::signal(SIGTERM, previous_term_);
-  }
-
- private:
-  void (*previous_int_)(int);
-  void (*previous_term_)(int);
-};
 
 torch::Tensor bytes_tensor(const std::string& bytes) {
   return torch::from_blob(const_cast<char*>(bytes.data()), {int64_t(bytes.size())}, torch::kUInt8)
@@ -390,7 +363,7 @@ double Trainer::evaluate_psnr(const std::vector<TrainView>& views) const {
 }
 
 TrainSummary Trainer::run() {
-  InterruptScope interrupt_scope;
+  const InterruptScope interrupt_scope;
   TrainSummary summary;
   ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations,
                   config_.log_every, seconds_before_);
@@ -412,7 +385,7 @@ TrainSummary Trainer::run() {
     }
     // After the report: an opacity reset on the same iteration would make it read ~12 dB.
     refine(iteration_);
-    const bool interrupted = interrupt_requested.load();
+    const bool interrupted = interrupt_requested();
     log.record(iteration_, last_loss_, model_.size(), test_psnr, last || interrupted);
     if (last || interrupted ||
         (config_.checkpoint_every > 0 && iteration_ % config_.checkpoint_every == 0)) {

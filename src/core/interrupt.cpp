@@ -1,0 +1,42 @@
+#include "core/interrupt.hpp"
+
+#include <atomic>
+#include <csignal>
+
+#include "core/error.hpp"
+
+namespace iesrgs {
+
+namespace {
+
+std::atomic<bool> requested{false};
+int open_scopes = 0;  // scopes are made by the main thread only
+
+extern "C" void request_interrupt(int signal) {
+  requested = true;
+  std::signal(signal, SIG_DFL);  // a second Ctrl-C stops at once
+}
+
+}  // namespace
+
+InterruptScope::InterruptScope() {
+  if (open_scopes++ == 0) requested = false;
+  previous_int_ = std::signal(SIGINT, request_interrupt);
+  previous_term_ = std::signal(SIGTERM, request_interrupt);
+}
+
+InterruptScope::~InterruptScope() {
+  std::signal(SIGINT, previous_int_);
+  std::signal(SIGTERM, previous_term_);
+  --open_scopes;
+}
+
+bool interrupt_requested() {
+  return requested.load();
+}
+
+void stop_if_interrupted(const std::string& what) {
+  if (requested.load()) throw Interrupted(what + " stopped; run the same command again to resume");
+}
+
+}  // namespace iesrgs

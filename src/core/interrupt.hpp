@@ -1,0 +1,29 @@
+#pragma once
+// SIGINT (Ctrl-C) and SIGTERM (kill, timeout, docker stop) ask long work to stop at its next safe
+// point, while an InterruptScope is alive; outside one they end the process as usual. A second
+// signal ends it at once.
+#include <string>
+
+namespace iesrgs {
+
+// Catches the two signals for its lifetime. Scopes nest: an inner one keeps a request the outer
+// one received, and each gives the handlers back as it found them.
+class InterruptScope {
+ public:
+  InterruptScope();
+  ~InterruptScope();
+  InterruptScope(const InterruptScope&) = delete;
+  InterruptScope& operator=(const InterruptScope&) = delete;
+
+ private:
+  void (*previous_int_)(int);
+  void (*previous_term_)(int);
+};
+
+// Whether a signal asked the work to stop.
+bool interrupt_requested();
+
+// Throws Interrupted("<what> stopped; run the same command again to resume") when one did.
+void stop_if_interrupted(const std::string& what);
+
+}  // namespace iesrgs
