@@ -136,8 +136,15 @@ ColmapImage read_image(TextReader& in) {
   if (const char* problem = image_name_problem(image.name))
     in.fail(fmt::format("image {}: NAME {}", image.id, problem));
   // A missing second line at the very end of the file is read as an image without 2D points.
-  if (in.next_line())
+  if (!in.next_line()) return image;
+  try {
     while (!in.at_line_end()) image.observations.push_back(read_observation(in));
+  } catch (const Error& e) {
+    // A file that leaves the second lines out fails here, on the next image's pose.
+    throw Error(std::string(e.what()) +
+                " (each image takes two lines: its pose and name, then its 2D points as X Y "
+                "POINT3D_ID, an empty line for none)");
+  }
   return image;
 }
 

@@ -457,7 +457,13 @@ TEST(Colmap, MalformedTextNamesFileAndLine) {
   expect_error([&] { parse_colmap_images("2 1 0 0 0 5 6 7 1\n\n", text, "i.txt"); },
                {"i.txt: line 1", "NAME is empty"});
   expect_error([&] { parse_colmap_images("2 1 0 0 0 5 6 7 1 a.png\n0.5 1.5\n", text, "i.txt"); },
-               {"i.txt: line 2", "missing POINT3D_ID"});
+               {"i.txt: line 2", "missing POINT3D_ID", "each image takes two lines"});
+  // Without the 2D points' lines, the second image's pose is read as points.
+  expect_error(
+      [&] {
+        parse_colmap_images("1 1 0 0 0 0 0 0 1 a.png\n2 1 0 0 0 5 6 7 1 b.png\n", text, "i.txt");
+      },
+      {"i.txt: line 2", "2D point X 'b.png' is not", "each image takes two lines"});
   expect_error([&] { parse_colmap_points("3 1 2 3 4 5 256 0.5\n", text, "p.txt"); },
                {"p.txt: line 1", "B '256' is not a valid number"});
   expect_error([&] { parse_colmap_points("3 1 2 3 4 5 6 0.5 2\n", text, "p.txt"); },
