@@ -245,6 +245,25 @@ void Pipeline::check_cached_inputs() const {
             o_.output / "internal", "internal", "iesrgs internal or iesrgs run");
 }
 
+// A folder written before rows kept their own scores holds them in results.json alone: each
+// row still there gets its entry before the table goes.
+void keep_table_scores_in_rows(const fs::path& output) {
+  const nlohmann::json table = read_stage_record(output / "results.json");
+  const nlohmann::json rows = table.value("rows", nlohmann::json());
+  if (!rows.is_array()) return;
+  for (const nlohmann::json& entry : rows) {
+    if (!entry.is_object() || !entry.value("row", nlohmann::json()).is_string()) continue;
+    const std::string id = entry["row"].get<std::string>();
+    const fs::path dir = output / "rows" / id;
+    std::error_code ec;
+    if (!find_row(id) || !fs::is_directory(dir, ec) || fs::exists(dir / kRowResultFile, ec))
+      continue;
+    const nlohmann::json record = {{"evaluation", table.value("evaluation", nlohmann::json())},
+                                   {"row", entry}};
+    write_file_atomically(dir / kRowResultFile, record.dump(2) + "\n");
+  }
+}
+
 // An interrupted run leaves no table, row scores or test renders of an earlier one that read as
 // its own: the table is written again when the run finishes, each row's scores and test views
 // when the row is scored. `iesrgs internal` scores nothing, so it does this only when it makes
@@ -258,6 +277,7 @@ void Pipeline::forget_earlier_results() const {
       (!scoring || rows_use_internal_references()) &&
       !internal_model_current(lr_scene_, train_digest_, o_.internal_config, o_.output / "internal");
   if (!scoring && !internal_changes) return;
+  keep_table_scores_in_rows(o_.output);
   for (const char* table : {"results.md", "results.csv", "results.json"})
     remove_earlier_output(o_.output / table, "left by an earlier run");
   const auto forget_row = [this](const std::string& id) {
@@ -612,7 +632,8 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
       if (!internal_current)
         internal_current = internal_stage_current(lr_scene_, train_digest_, o_.internal_config,
                                                   o_.scale, o_.output / "internal");
-      if (entry.at("row") != id || !row_current(row, entry, *internal_current)) continue;
+      const bool recorded_here = entry.at("row") == id;  // not a copy of another row's file
+      if (!recorded_here || !row_current(row, entry, *internal_current)) continue;
       result.rows.push_back(earlier_row(row, row_label(row), entry));
       if (!same("lpips")) result.rows.back().mean.lpips.reset();
     } catch (const nlohmann::json::exception&) {

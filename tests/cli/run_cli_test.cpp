@@ -441,6 +441,19 @@ TEST_F(RunCli, AnEarlierRowIsKeptOnlyForTheModelItScored) {
   EXPECT_EQ(results["rows"][0]["row"], "bicubic");
 }
 
+// A folder written before rows kept their own scores had them in results.json alone.
+TEST_F(RunCli, RowsOfAnOlderFolderAreKeptFromItsTable) {
+  ASSERT_EQ(write_scene(32, 4, 1), 0);
+  ASSERT_EQ(run_rows("bicubic,external").status, 0);
+  for (const char* row : {"bicubic", "external"})
+    std::filesystem::remove(dir / "run" / "rows" / row / "result.json");
+  ASSERT_EQ(run_rows("bicubic").status, 0);
+  const auto results = nlohmann::json::parse(read_file(dir / "run" / "results.json"));
+  ASSERT_EQ(results["rows"].size(), 2u) << results.dump();
+  EXPECT_EQ(results["rows"][1]["row"], "external");
+  EXPECT_TRUE(results["rows"][1]["from_earlier_run"].get<bool>());
+}
+
 // A row scored under these settings is kept even when a run under other settings came between:
 // the table of that run left it out, its own folder kept its scores.
 TEST_F(RunCli, ARowComesBackWithTheSettingsItWasScoredUnder) {
