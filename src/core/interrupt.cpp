@@ -26,8 +26,10 @@ InterruptScope::InterruptScope() {
 }
 
 InterruptScope::~InterruptScope() {
-  std::signal(SIGINT, previous_int_);
-  std::signal(SIGTERM, previous_term_);
+  // Inside an outer scope after a request, the outer handlers would catch a second signal too.
+  const bool asked_inside = requested.load() && open_scopes > 1;
+  std::signal(SIGINT, asked_inside ? SIG_DFL : previous_int_);
+  std::signal(SIGTERM, asked_inside ? SIG_DFL : previous_term_);
   --open_scopes;
 }
 

@@ -651,6 +651,7 @@ RunResult run_ie_srgs(const RunOptions& options) {
   // Between views and iterations, every stage stops where a rerun resumes.
   const InterruptScope interrupts;
   Pipeline pipeline(options);
+  stop_if_interrupted("loading the scene");
   // Taken once the scenes have loaded, so that a run refused for its input leaves no folder.
   const FolderLock lock(options.output);
   RunResult result = pipeline.run();

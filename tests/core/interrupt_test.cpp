@@ -32,6 +32,8 @@ TEST(Interrupt, AnInnerScopeKeepsTheOuterScopesRequest) {
     const InterruptScope inner;
     EXPECT_TRUE(interrupt_requested());
   }
+  // A second signal would now end the process, not be caught by the outer scope's handler.
+  EXPECT_EQ(std::signal(SIGINT, SIG_DFL), SIG_DFL);
   outer.reset();
   const InterruptScope next;  // a new outermost scope starts afresh
   EXPECT_FALSE(interrupt_requested());
