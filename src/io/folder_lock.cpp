@@ -1,13 +1,16 @@
 #include "io/folder_lock.hpp"
 
 #include <fcntl.h>
+#include <fmt/core.h>
 #include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <string>
 #include <system_error>
+#include <thread>
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
@@ -18,6 +21,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Whether another process holds `folder`. The probe's own shared lock lasts an instant, which
+// FolderLock's retries ride out.
+bool held_elsewhere(const fs::path& folder) {
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool held = ::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::close(fd);
+  return held;
+}
+
+[[noreturn]] void fail_held(const fs::path& folder, const char* relation, const fs::path& held) {
+  fail_file(folder, fmt::format("{} {}, which another process is writing (an iesrgs command, "
+                                "say); wait for it to end (or stop it) first",
+                                relation, held.string()));
+}
+
 // A folder inside one that another process holds (a run's stage folders, say) is that process's
 // to write: a `train` or `render` there would change what the run has cached under it.
 void refuse_inside_held_folder(const fs::path& folder) {
@@ -25,16 +44,30 @@ void refuse_inside_held_folder(const fs::path& folder) {
   const fs::path absolute = fs::absolute(folder, ec);
   if (ec) return;
   for (fs::path above = absolute.parent_path(); above.has_relative_path();
-       above = above.parent_path()) {
-    const int fd = ::open(above.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd < 0) continue;
-    const bool held = ::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
-    ::close(fd);
-    if (held)
-      fail_file(folder, "inside " + above.string() +
-                            ", which another iesrgs process is writing; wait for it to end (or "
-                            "stop it) first");
+       above = above.parent_path())
+    if (held_elsewhere(above)) fail_held(folder, "inside", above);
+}
+
+// And the other way round: a run must not write over a stage folder that a `train` or `render`
+// is writing. Three levels cover a run's stage folders (rows/<row>/test).
+void refuse_around_held_folder(const fs::path& folder) {
+  std::error_code ec;
+  fs::recursive_directory_iterator it(folder, fs::directory_options::skip_permission_denied, ec);
+  for (; !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    if (it.depth() >= 2) it.disable_recursion_pending();
+    if (it->is_directory(ec) && !it->is_symlink(ec) && held_elsewhere(it->path()))
+      fail_held(folder, "above", it->path());
   }
+}
+
+bool lock_exclusively(int fd) {
+  constexpr int kTries = 20;  // 0.2 s: a neighbour's probe of this folder ends well before
+  for (int i = 0; i < kTries; ++i) {
+    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return true;
+    if (errno != EWOULDBLOCK) return true;  // no locks on this file system
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
 }
 
 }  // namespace
@@ -51,17 +84,20 @@ FolderLock::FolderLock(const fs::path& folder) {
   fd_ = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0)
     fail_file(folder, std::string("cannot open the output folder (") + std::strerror(errno) + ")");
-  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) {
-    remove_stale_temporaries(folder);
-    return;
+  if (!lock_exclusively(fd_)) {
+    ::close(fd_);
+    fd_ = -1;
+    fail_file(folder,
+              "in use by another iesrgs process; wait for it to end (or stop it) before writing "
+              "to this folder again");
   }
-  const int error = errno;
-  if (error != EWOULDBLOCK) return;  // no locks on this file system
-  ::close(fd_);
-  fd_ = -1;
-  fail_file(folder,
-            "in use by another iesrgs process; wait for it to end (or stop it) before writing "
-            "to this folder again");
+  try {
+    refuse_around_held_folder(folder);
+  } catch (...) {
+    ::close(fd_);
+    throw;
+  }
+  remove_stale_temporaries(folder);
 }
 
 FolderLock::~FolderLock() {

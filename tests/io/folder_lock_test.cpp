@@ -33,12 +33,19 @@ TEST(FolderLock, AFolderInsideAHeldOneIsRefused) {
   const auto stage = dir / "run" / "internal";
   const std::string message = error_message([&] { FolderLock train(stage); });
   EXPECT_TRUE(contains(message, stage.string() + ": inside " + (dir / "run").string() +
-                                    ", which another iesrgs process is writing"))
+                                    ", which another process is writing"))
       << message;
   EXPECT_FALSE(std::filesystem::exists(stage));
   run.reset();
-  FolderLock train(stage);
+  std::optional<FolderLock> train(stage);
   FolderLock beside(dir / "other");  // held folders lock only what is inside them
+  // Nor is a run taken over a stage folder that a training holds.
+  const std::string above = error_message([&] { FolderLock rerun(dir / "run"); });
+  EXPECT_TRUE(contains(above, (dir / "run").string() + ": above " + stage.string() +
+                                  ", which another process is writing"))
+      << above;
+  train.reset();
+  FolderLock rerun(dir / "run");
 }
 
 TEST(FolderLock, FoldersItCreatedAndLeftEmptyAreRemoved) {
