@@ -448,17 +448,20 @@ void read_body(Values values, const Header& header, const std::vector<const Slot
 // ---- point clouds ----
 
 constexpr const char* kPointProperties[6] = {"x", "y", "z", "red", "green", "blue"};
+constexpr size_t kNoProperty = SIZE_MAX;
+constexpr uint8_t kGrey = 128;  // the colour of points stored without one
 
-// Where each of kPointProperties sits among the vertex properties.
+// Where each of kPointProperties sits among the vertex properties; colours may be absent.
 std::array<size_t, 6> point_property_indices(const Header& header, const fs::path& name) {
   std::array<size_t, 6> index{};
   for (size_t k = 0; k < index.size(); ++k) {
     const auto it = std::find_if(header.properties.begin(), header.properties.end(),
                                  [&](const Property& p) { return p.name == kPointProperties[k]; });
-    if (it == header.properties.end())
-      fail_file(name, fmt::format("missing property '{}' (a point cloud has x y z red green blue)",
+    index[k] = it == header.properties.end() ? kNoProperty : size_t(it - header.properties.begin());
+    if (k < 3 && index[k] == kNoProperty)
+      fail_file(name, fmt::format("missing property '{}' (a point cloud has x y z, and may have "
+                                  "red green blue)",
                                   kPointProperties[k]));
-    index[k] = size_t(it - header.properties.begin());
   }
   return index;
 }
@@ -483,8 +486,11 @@ PointCloud read_points(Values values, const Header& header, const fs::path& name
         fail_file(name, fmt::format("vertex {}: property '{}' is not a finite float ({})", i,
                                     kPointProperties[k], row[index[k]]));
     points.positions[i] = {row[index[0]], row[index[1]], row[index[2]]};
-    for (size_t c = 0; c < 3; ++c)
-      points.colors[i][c] = color_byte(row[index[3 + c]], header.properties[index[3 + c]].type);
+    for (size_t c = 0; c < 3; ++c) {
+      const size_t p = index[3 + c];
+      points.colors[i][c] =
+          p == kNoProperty ? kGrey : color_byte(row[p], header.properties[p].type);
+    }
   }
   return points;
 }

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "io/scene.hpp"
+#include "io/point_cloud.hpp"
 
 namespace iesrgs {
 
@@ -67,10 +67,10 @@ SplatCloud read_ply(const std::filesystem::path& path);
 // read_ply on bytes already in memory; `name` is only used in error messages.
 SplatCloud parse_ply(std::string_view bytes, const std::filesystem::path& name);
 
-// The x y z and red green blue of a point cloud's vertices, as 3DGS reads a scene's points3D.ply
-// and nerfstudio its ply_file_path: ascii or binary_little_endian, any scalar types, colours as
-// bytes or, stored as floats, in [0, 1]. Other properties are skipped. Throws Error naming the
-// file for anything it cannot use.
+// The x y z and red green blue of a point cloud's vertices, as nerfstudio reads a scene's
+// ply_file_path: ascii or binary_little_endian, any scalar types, colours as bytes or, stored as
+// floats, in [0, 1], and grey where there are none. Other properties are skipped. Throws Error
+// naming the file for anything it cannot use.
 PointCloud read_point_ply(const std::filesystem::path& path);
 
 // read_point_ply on bytes already in memory; `name` is only used in error messages.

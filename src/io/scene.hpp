@@ -8,14 +8,9 @@
 #include <vector>
 
 #include "io/camera.hpp"
+#include "io/point_cloud.hpp"
 
 namespace iesrgs {
-
-// Sparse SfM points (COLMAP points3D), empty for synthetic scenes.
-struct PointCloud {
-  std::vector<Vec3> positions;
-  std::vector<std::array<uint8_t, 3>> colors;
-};
 
 // Scene center and extent exactly as 3DGS's getNerfppNorm: center of the camera centers, radius
 // = 1.1 x the largest distance of a camera center from it. Learning rates scale with `radius`.
@@ -28,7 +23,7 @@ struct Scene {
   std::filesystem::path root;
   std::string format;  // "blender", "nerfstudio" or "colmap"
   std::vector<Camera> cameras;
-  PointCloud points;
+  PointCloud points;                         // empty for synthetic scenes
   std::array<float, 3> background{1, 1, 1};  // rendered behind the model; RGBA images over it
   bool synthetic = false;  // object-centric with a known bounding volume (NeRF Synthetic)
   int downscale = 1;       // cameras' intrinsics are the stored ones divided by this

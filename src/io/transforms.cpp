@@ -1,5 +1,6 @@
 #include "io/transforms.hpp"
 
+#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -342,6 +343,7 @@ std::optional<SplitLists> read_split_lists(const json& document, const fs::path&
     fail_file(json_path, fmt::format("\"{}\" without \"train_filenames\": the split lists must "
                                      "name the training images too",
                                      lists.test_key));
+  if (train->empty()) fail_file(json_path, "\"train_filenames\" is empty: nothing to train on");
   lists.train = std::move(*train);
   if (test) lists.test = std::move(*test);
   return lists;
@@ -411,8 +413,12 @@ Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_
   if (const json* ply = find(document, "ply_file_path")) {
     if (!ply->is_string() || ply->get_ref<const std::string&>().empty())
       fail_file(json_path, "\"ply_file_path\" must be a file name");
-    scene.points =
-        read_points((json_path.parent_path() / ply->get<std::string>()).lexically_normal());
+    try {
+      scene.points =
+          read_points((json_path.parent_path() / ply->get<std::string>()).lexically_normal());
+    } catch (const Error& e) {
+      fail_file(json_path, fmt::format("\"ply_file_path\": {}", e.what()));
+    }
   }
   if (const std::optional<SplitLists> lists = read_split_lists(document, json_path)) {
     assign_listed_splits(cameras, *lists, json_path, scene.cameras);
@@ -446,9 +452,17 @@ Scene read_blender_scene(const fs::path& root, const SceneOptions&) {
   return scene;
 }
 
+// As nerfstudio, a point file that is not there leaves the scene without points.
+PointCloud read_point_ply_if_present(const fs::path& path) {
+  std::error_code ec;
+  if (fs::exists(path, ec)) return read_point_ply(path);
+  spdlog::warn("{}: not found, so training starts from random points", path.string());
+  return {};
+}
+
 Scene read_nerfstudio_scene(const fs::path& transforms_json, const SceneOptions& options) {
   Scene scene = parse_nerfstudio_transforms(read_file(transforms_json), transforms_json, options,
-                                            read_image_header, read_point_ply);
+                                            read_image_header, read_point_ply_if_present);
   require_images_exist(scene.cameras, transforms_json);
   return scene;
 }

@@ -88,6 +88,8 @@ bool cached_view_intact(const std::filesystem::path& image, const std::filesyste
 std::string split_digest(const ViewImages& images, Split split) {
   const Scene& scene = images.scene();
   std::string key = fmt::format("background {};\n", fmt::join(scene.background, " "));
+  // The lens as it was keyed before FULL_OPENCV's terms were read, and those only when used,
+  // so that run folders of OPENCV captures keep their stages.
   for (const Camera* camera : scene.split(split)) {
     const Intrinsics& k = camera->intrinsics;
     const Distortion& d = camera->distortion;

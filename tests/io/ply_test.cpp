@@ -226,15 +226,19 @@ TEST(Ply, PointCloudsAsOpen3dAndColmapWriteThem) {
   EXPECT_EQ(points.colors[0], (std::array<uint8_t, 3>{255, 128, 255}));
   EXPECT_EQ(points.colors[1], (std::array<uint8_t, 3>{0, 0, 0}));
 
-  // A Gaussian splatting model has no red: it is not a point cloud.
-  const std::string model =
+  // Points without colours are grey; without a position, no points.
+  const std::string bare =
       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
-      "property float y\nproperty float z\nproperty float f_dc_0\n"
+      "property float y\nproperty float z\nproperty float nx\n"
       "end_header\n1 2 3 0.5\n";
-  EXPECT_NE(error_message([&] {
-              parse_point_ply(model, "model.ply");
-            }).find("model.ply: missing property 'red' (a point cloud has x y z red green blue)"),
-            std::string::npos);
+  EXPECT_EQ(parse_point_ply(bare, "bare.ply").colors[0], (std::array<uint8_t, 3>{128, 128, 128}));
+  const std::string flat =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+      "property float y\nproperty uchar red\nend_header\n1 2 3\n";
+  const std::string message = error_message([&] { parse_point_ply(flat, "flat.ply"); });
+  EXPECT_NE(message.find("flat.ply: missing property 'z' (a point cloud has x y z"),
+            std::string::npos)
+      << message;
   const std::string infinite =
       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
       "property float y\nproperty double z\nproperty uchar red\n"

@@ -220,6 +220,11 @@ TEST(NerfstudioScene, SplitListsSetTheSplitAsNerfstudio) {
               parse_in_memory(document);
             }).find("\"test_filenames\" names /data/images/f.jpg, which no frame's file_path does"),
             std::string::npos);
+  document["train_filenames"] = json::array();
+  EXPECT_NE(error_message([&] {
+              parse_in_memory(document);
+            }).find("\"train_filenames\" is empty: nothing to train on"),
+            std::string::npos);
   document.erase("train_filenames");
   EXPECT_NE(error_message([&] {
               parse_in_memory(document);
@@ -241,10 +246,22 @@ TEST(NerfstudioScene, PlyFilePathGivesThePoints) {
              "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
              "property float z\nproperty uint8 red\nproperty uint8 green\nproperty uint8 blue\n"
              "end_header\n0.5 -1 2 255 128 0\n3 4 5 1 2 3\n");
-  const Scene scene = read_nerfstudio_scene(write_nerfstudio_scene(dir, document), {});
+  const fs::path json_path = write_nerfstudio_scene(dir, document);
+  const Scene scene = read_nerfstudio_scene(json_path, {});
   ASSERT_EQ(scene.points.positions.size(), 2u);
   EXPECT_EQ(scene.points.positions[0].y, -1);
   EXPECT_EQ(scene.points.colors[0], (std::array<uint8_t, 3>{255, 128, 0}));
+
+  // As nerfstudio, a point file that is not there leaves random points to start from; one that
+  // is there must be readable.
+  write_text(dir / "sparse_pc.ply", "ply\nformat ascii 1.0\nend_header\n");
+  const std::string message = error_message([&] { read_nerfstudio_scene(json_path, {}); });
+  EXPECT_NE(message.find(json_path.string() + ": \"ply_file_path\": " +
+                         (dir / "sparse_pc.ply").string() + ": the header has no vertex element"),
+            std::string::npos)
+      << message;
+  fs::remove(dir / "sparse_pc.ply");
+  EXPECT_TRUE(read_nerfstudio_scene(json_path, {}).points.positions.empty());
 }
 
 TEST(NerfstudioScene, ThreeRowMatrixIsAPose) {
