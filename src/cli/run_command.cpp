@@ -21,17 +21,8 @@ struct TrainingArgs {
   int64_t iterations = 0;
   int views_per_iteration;
   std::vector<std::string> assignments;
-  std::string option_prefix = "--";  // "--" or "--internal-": named in errors
-  const CLI::Option* iterations_option = nullptr;
-  const CLI::Option* views_option = nullptr;
-
-  // The options that set a parameter which `assignments` set again.
-  void refuse_sets_beside_options(const CLI::Option& seed_option) const {
-    const std::string set_flag = option_prefix + "set";
-    refuse_set_beside_option(*iterations_option, "iterations", assignments, set_flag);
-    refuse_set_beside_option(*views_option, "views_per_iteration", assignments, set_flag);
-    refuse_set_beside_option(seed_option, "seed", assignments, set_flag);
-  }
+  std::string option_prefix = "--";    // "--" or "--internal-": named in errors
+  TrainingParameterOptions options{};  // the seed's is the command's, shared by both trainings
 
   train::TrainConfig resolve(uint64_t seed) const {
     train::TrainConfig config = train::make_preset(preset, iterations);
@@ -85,16 +76,17 @@ void add_training_options(CLI::App& command, TrainingArgs& args, const std::stri
   const std::string prefix = stage.empty() ? "--" : "--" + stage + "-";
   command.add_option(prefix + "preset", args.preset, what + " schedule: paper, cpu, fast")
       ->capture_default_str();
-  args.iterations_option =
+  args.options.iterations =
       command
           .add_option(prefix + "iterations", args.iterations,
                       what + " iterations; the preset's schedule is rescaled to fit")
           ->check(kPositive);
-  args.views_option = command
-                          .add_option(prefix + "mv", args.views_per_iteration,
-                                      what + " views per iteration (multi-view regulation K)")
-                          ->check(kPositive)
-                          ->capture_default_str();
+  args.options.views_per_iteration =
+      command
+          .add_option(prefix + "mv", args.views_per_iteration,
+                      what + " views per iteration (multi-view regulation K)")
+          ->check(kPositive)
+          ->capture_default_str();
   args.option_prefix = prefix;
   command.add_option(prefix + "set", args.assignments,
                      what + " training parameter key=value (repeatable; see config.json)");
@@ -171,8 +163,11 @@ void add_pipeline_command(CLI::App& app, const std::string& name, const std::str
                           ->check(kNonNegative);
   add_device_option(*command, args->device);
   command->callback([args, only, seed] {
-    args->internal.refuse_sets_beside_options(*seed);
-    args->fusion.refuse_sets_beside_options(*seed);
+    for (TrainingArgs* training : {&args->internal, &args->fusion}) {
+      training->options.seed = seed;
+      refuse_sets_beside_options(training->options, training->assignments,
+                                 training->option_prefix + "set");
+    }
     run_pipeline(*args, only);
   });
 }

@@ -48,14 +48,20 @@ void add_tile_options(CLI::App& command, priors::sr::TileOptions& tiles) {
       ->check(kNonNegative);
 }
 
-void refuse_set_beside_option(const CLI::Option& option, const std::string& key,
-                              const std::vector<std::string>& assignments,
-                              const std::string& set_flag) {
-  if (option.count() == 0) return;
-  for (const std::string& assignment : assignments)
-    if (assignment.rfind(key + "=", 0) == 0)
-      fail("{} and {} {} both set {}: give one of them", option.get_name(), set_flag, assignment,
-           key);
+void refuse_sets_beside_options(const TrainingParameterOptions& options,
+                                const std::vector<std::string>& assignments,
+                                const std::string& set_flag) {
+  for (const auto& [option, key] : {std::pair{options.iterations, "iterations"},
+                                    std::pair{options.views_per_iteration, "views_per_iteration"},
+                                    std::pair{options.seed, "seed"}}) {
+    if (option->count() == 0) continue;
+    // The key as apply_assignment reads it: everything before the first '=', untrimmed.
+    const std::string prefix = std::string(key) + "=";
+    for (const std::string& assignment : assignments)
+      if (assignment.rfind(prefix, 0) == 0)
+        fail("{} and {} {} both set {}: give one of them", option->get_name(), set_flag, assignment,
+             key);
+  }
 }
 
 void use_device(const std::string& device) {

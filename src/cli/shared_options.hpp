@@ -23,11 +23,18 @@ void add_gray_background_option(CLI::App& command, float& gray);
 // Adds --tile and --tile-overlap, how the SR networks' commands cut an image, stored in `tiles`.
 void add_tile_options(CLI::App& command, priors::sr::TileOptions& tiles);
 
-// Throws Error when `option` was given and one of `assignments`, the values of `set_flag`, sets
-// `key`, the training parameter that option sets: which of the two should win would be a guess.
-void refuse_set_beside_option(const CLI::Option& option, const std::string& key,
-                              const std::vector<std::string>& assignments,
-                              const std::string& set_flag);
+// The options that set a training parameter of their own, which a --set may set again.
+struct TrainingParameterOptions {
+  const CLI::Option* iterations = nullptr;
+  const CLI::Option* views_per_iteration = nullptr;
+  const CLI::Option* seed = nullptr;
+};
+
+// Throws Error when one of `options` was given and one of `assignments`, the values of
+// `set_flag`, sets the same parameter: which of the two should win would be a guess.
+void refuse_sets_beside_options(const TrainingParameterOptions& options,
+                                const std::vector<std::string>& assignments,
+                                const std::string& set_flag);
 
 // Makes `device` this process's compute device (core/device.hpp) and says which it is. Throws
 // Error when it names a GPU this build or machine cannot use.

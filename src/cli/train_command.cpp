@@ -186,9 +186,7 @@ void add_train_command(CLI::App& app) {
                     "Continue the run in --output from its checkpoint, with its saved config");
   add_device_option(*command, args->device);
   command->callback([args, run_options, preset, iterations, mv, seed] {
-    refuse_set_beside_option(*iterations, "iterations", args->assignments, "--set");
-    refuse_set_beside_option(*mv, "views_per_iteration", args->assignments, "--set");
-    refuse_set_beside_option(*seed, "seed", args->assignments, "--set");
+    refuse_sets_beside_options({iterations, mv, seed}, args->assignments, "--set");
     for (const CLI::Option* option : run_options) args->run_options_given |= option->count() > 0;
     args->preset_given = preset->count() > 0;
     run_train(*args);
