@@ -473,8 +473,8 @@ uint8_t color_byte(double value, Scalar type) {
 }
 
 template <typename Values>
-PointCloud read_points(Values values, const Header& header, const fs::path& name) {
-  const std::array<size_t, 6> index = point_property_indices(header, name);
+PointCloud read_points(Values values, const Header& header, const std::array<size_t, 6>& index,
+                       const fs::path& name) {
   PointCloud points;
   points.positions.resize(header.vertex_count);
   points.colors.resize(header.vertex_count);
@@ -563,11 +563,12 @@ PointCloud read_point_ply(const fs::path& path) {
 
 PointCloud parse_point_ply(std::string_view bytes, const fs::path& name) {
   const Header header = HeaderParser(bytes, name).parse();
-  point_property_indices(header, name);  // before check_count_fits, which needs properties
+  // First: check_count_fits needs properties, which this finds at least three of.
+  const std::array<size_t, 6> index = point_property_indices(header, name);
   const std::string_view body = bytes.substr(header.body_offset);
   check_count_fits(header, body.size(), name);
-  if (header.ascii) return read_points(AsciiValues(body, name), header, name);
-  return read_points(BinaryValues(body), header, name);
+  if (header.ascii) return read_points(AsciiValues(body, name), header, index, name);
+  return read_points(BinaryValues(body), header, index, name);
 }
 
 }  // namespace iesrgs

@@ -245,25 +245,6 @@ void Pipeline::check_cached_inputs() const {
             o_.output / "internal", "internal", "iesrgs internal or iesrgs run");
 }
 
-// A folder written before rows kept their own scores holds them in results.json alone: each
-// row still there gets its entry before the table goes.
-void keep_table_scores_in_rows(const fs::path& output) {
-  const nlohmann::json table = read_stage_record(output / "results.json");
-  const nlohmann::json rows = table.value("rows", nlohmann::json());
-  if (!rows.is_array()) return;
-  for (const nlohmann::json& entry : rows) {
-    if (!entry.is_object() || !entry.value("row", nlohmann::json()).is_string()) continue;
-    const std::string id = entry["row"].get<std::string>();
-    const fs::path dir = output / "rows" / id;
-    std::error_code ec;
-    if (!find_row(id) || !fs::is_directory(dir, ec) || fs::exists(dir / kRowResultFile, ec))
-      continue;
-    const nlohmann::json record = {{"evaluation", table.value("evaluation", nlohmann::json())},
-                                   {"row", entry}};
-    write_file_atomically(dir / kRowResultFile, record.dump(2) + "\n");
-  }
-}
-
 // An interrupted run leaves no table, row scores or test renders of an earlier one that read as
 // its own: the table is written again when the run finishes, each row's scores and test views
 // when the row is scored. `iesrgs internal` scores nothing, so it does this only when it makes

@@ -6,6 +6,7 @@
 
 #include "core/progress.hpp"
 #include "io/atomic_file.hpp"
+#include "pipeline/stage_record.hpp"
 
 namespace iesrgs::pipeline {
 
@@ -54,12 +55,33 @@ std::string stages_markdown(const RunResult& result) {
   return md;
 }
 
+void write_row_record(const std::filesystem::path& row_dir, const nlohmann::json& entry,
+                      const nlohmann::json& evaluation) {
+  const nlohmann::json record = {{"evaluation", evaluation}, {"row", entry}};
+  write_file_atomically(row_dir / kRowResultFile, record.dump(2) + "\n");
+}
+
 }  // namespace
 
 void write_row_result(const std::filesystem::path& row_dir, const RowResult& row,
                       const nlohmann::json& evaluation) {
-  const nlohmann::json record = {{"evaluation", evaluation}, {"row", row_json(row)}};
-  write_file_atomically(row_dir / kRowResultFile, record.dump(2) + "\n");
+  write_row_record(row_dir, row_json(row), evaluation);
+}
+
+void keep_table_scores_in_rows(const std::filesystem::path& output) {
+  const nlohmann::json table = read_stage_record(output / "results.json");
+  const nlohmann::json rows = table.value("rows", nlohmann::json());
+  if (!rows.is_array()) return;
+  for (const nlohmann::json& entry : rows) {
+    if (!entry.is_object() || !entry.value("row", nlohmann::json()).is_string()) continue;
+    const std::string id = entry["row"].get<std::string>();
+    const std::filesystem::path dir = output / "rows" / id;
+    std::error_code ec;
+    if (!find_row(id) || !std::filesystem::is_directory(dir, ec) ||
+        std::filesystem::exists(dir / kRowResultFile, ec))
+      continue;
+    write_row_record(dir, entry, table.value("evaluation", nlohmann::json()));
+  }
 }
 
 RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry) {

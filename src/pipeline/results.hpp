@@ -34,6 +34,10 @@ inline constexpr char kRowResultFile[] = "result.json";
 void write_row_result(const std::filesystem::path& row_dir, const RowResult& row,
                       const nlohmann::json& evaluation);
 
+// A folder written before rows kept their own scores holds them in <output>/results.json alone:
+// gives each row whose folder is still there, and has no result.json, its entry from the table.
+void keep_table_scores_in_rows(const std::filesystem::path& output);
+
 // The row of an earlier run's entry; kept only under the current settings, so its label is the
 // one they give.
 RowResult earlier_row(const RowSpec& spec, std::string label, const nlohmann::json& entry);
