@@ -9,6 +9,7 @@
 #include "cli/commands.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/torch_error.hpp"
 
 int main(int argc, char** argv) {
@@ -56,7 +57,7 @@ int main(int argc, char** argv) {
   } catch (const iesrgs::Interrupted& e) {
     std::fflush(stdout);
     std::fprintf(stderr, "interrupted: %s\n", e.what());
-    return 130;
+    return iesrgs::interrupt_exit_status();
   } catch (...) {
     return report(iesrgs::current_exception_message().c_str());
   }

@@ -14,8 +14,8 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Training stopped by Ctrl-C after saving its checkpoint: the CLI says so and exits with 130, the
-// shell's status for SIGINT, so scripts see that the run did not finish.
+// Work stopped by Ctrl-C or SIGTERM at a safe point: the CLI says so and exits with the shell's
+// status for that signal (130 or 143), so scripts see that the run did not finish.
 class Interrupted : public Error {
  public:
   using Error::Error;

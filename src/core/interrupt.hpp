@@ -23,6 +23,9 @@ class InterruptScope {
 // Whether a signal asked the work to stop.
 bool interrupt_requested();
 
+// The shell's status for a process the signal ended: 130 for SIGINT, 143 for SIGTERM.
+int interrupt_exit_status();
+
 // Throws Interrupted("<what> stopped; run the same command again to resume") when one did.
 void stop_if_interrupted(const std::string& what);
 

@@ -22,8 +22,8 @@ struct StageResult {
 };
 
 // Trains (or loads) the stage in setup.output_dir and writes its point clouds there. `params`
-// identifies the stage's inputs beyond the training config. Throws Interrupted (exit status 130)
-// on SIGINT or SIGTERM, after the checkpoint is written, saying how to resume.
+// identifies the stage's inputs beyond the training config. Throws Interrupted on SIGINT or
+// SIGTERM, after the checkpoint is written, saying how to resume.
 StageResult run_training_stage(const std::string& name, const nlohmann::json& params,
                                const train::TrainConfig& config, train::TrainerSetup setup,
                                const std::function<gs::GaussianModel()>& initial_model);

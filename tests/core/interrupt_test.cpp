@@ -19,6 +19,7 @@ TEST(Interrupt, ASignalInsideAScopeAsksTheWorkToStop) {
   stop_if_interrupted("the external stage");  // nothing asked: goes on
   std::raise(SIGTERM);
   EXPECT_TRUE(interrupt_requested());
+  EXPECT_EQ(interrupt_exit_status(), 128 + SIGTERM);  // 143, as if the signal had ended it
   EXPECT_THROW(stop_if_interrupted("rendering"), Interrupted);
   EXPECT_EQ(error_message([] { stop_if_interrupted("rendering"); }),
             "rendering stopped; run the same command again to resume");
@@ -31,6 +32,7 @@ TEST(Interrupt, AnInnerScopeKeepsTheOuterScopesRequest) {
   {
     const InterruptScope inner;
     EXPECT_TRUE(interrupt_requested());
+    EXPECT_EQ(interrupt_exit_status(), 128 + SIGINT);
   }
   // A second signal would now end the process, not be caught by the outer scope's handler.
   EXPECT_EQ(std::signal(SIGINT, SIG_DFL), SIG_DFL);
