@@ -14,10 +14,10 @@
 #include "cli/validators.hpp"
 #include "core/error.hpp"
 #include "core/memory.hpp"
-#include "core/paths.hpp"
 #include "core/progress.hpp"
 #include "io/camera.hpp"
 #include "io/image.hpp"
+#include "io/image_jobs.hpp"
 #include "io/image_tensor.hpp"
 #include "priors/sr/registry.hpp"
 #include "priors/sr/sr_net.hpp"
@@ -40,44 +40,10 @@ struct UpscaleArgs {
   std::string device = "auto";
 };
 
-struct Job {
-  fs::path input, output;
-};
-
-// Every PNG / JPEG of `folder`, in name order, to a PNG of the same stem in `out`.
-std::vector<Job> folder_jobs(const fs::path& folder, const fs::path& out) {
-  if (fs::exists(out) && !fs::is_directory(out))
-    fail_file(out, "is a file, but the input is a folder");
-  const std::vector<fs::path> images = image_files_in(folder);
-  // a.png and a.jpg would both become a.png, the second overwriting the first.
-  if (const auto shared = first_shared_stem(images))
-    fail_file(folder,
-              fmt::format("{} and {} would both be upscaled to {}; rename one",
-                          shared->first.filename().string(), shared->second.filename().string(),
-                          (out / shared->first.stem().concat(".png")).string()));
-  std::vector<Job> jobs;
-  for (const fs::path& image : images) jobs.push_back({image, out / image.stem().concat(".png")});
-  return jobs;
-}
-
-std::vector<Job> named_jobs(const fs::path& input, const fs::path& output) {
-  if (fs::is_directory(input)) return folder_jobs(input, output);
-  if (!fs::exists(input)) fail_file(input, "no such image or folder");
-  if (fs::is_directory(output)) return {{input, output / input.stem().concat(".png")}};
-  if (lowercase_extension(output) != ".png")
-    fail_file(output,
-              "upscale writes PNG images: name the output .png, or give an existing folder");
-  return {{input, output}};
-}
-
-// The jobs, none of which may write over its own input.
-std::vector<Job> jobs_for(const fs::path& input, const fs::path& output) {
-  std::vector<Job> jobs = named_jobs(input, output);
-  for (const Job& job : jobs) {
-    std::error_code ec;  // set, and false returned, when the output does not exist yet
-    if (fs::equivalent(job.input, job.output, ec))
-      fail_file(job.output, "is the input itself; write the upscaled images elsewhere");
-  }
+// The jobs, none of which may write over an input or another's result.
+std::vector<ImageJob> plan_jobs(const fs::path& input, const fs::path& output) {
+  std::vector<ImageJob> jobs = plan_image_jobs(input, output, ".png", "upscale");
+  refuse_overwrites(jobs);
   return jobs;
 }
 
@@ -87,7 +53,7 @@ std::vector<Job> jobs_for(const fs::path& input, const fs::path& output) {
 constexpr int64_t kUpscaleBytesPerPixel = 32;
 
 // Refuses, before upscaling, an output larger than any image read here or than the memory.
-void require_output_fits(const Job& job, int64_t width, int64_t height) {
+void require_output_fits(const ImageJob& job, int64_t width, int64_t height) {
   if (std::max(width, height) > kMaxImageSide)
     fail_file(job.input, fmt::format("upscaled, it would be {}x{} pixels (at most {} a side)",
                                      width, height, kMaxImageSide));
@@ -96,24 +62,24 @@ void require_output_fits(const Job& job, int64_t width, int64_t height) {
 }
 
 // Decodes, composites any alpha over the background, upscales and writes one image.
-std::pair<int, int> upscale_one(SrNet& net, const UpscaleArgs& args, const Job& job) {
+std::pair<int, int> upscale_one(SrNet& net, const UpscaleArgs& args, const ImageJob& job) {
   const float background[3] = {args.background, args.background, args.background};
   const Image rgb = composite_rgb(read_image8(job.input), background);
   require_output_fits(job, int64_t(rgb.width) * args.scale, int64_t(rgb.height) * args.scale);
   const torch::Tensor upscaled = priors::sr::upscale_tiled(net, to_tensor(rgb), args.tiles);
-  write_png(job.output, to_image8(upscaled));
+  write_png(job.outputs[0], to_image8(upscaled));
   return {rgb.width, rgb.height};
 }
 
 void run(const UpscaleArgs& args) {
   use_device(args.device);
-  const std::vector<Job> jobs = jobs_for(args.input, args.output);
+  const std::vector<ImageJob> jobs = plan_jobs(args.input, args.output);
   const std::unique_ptr<SrNet> net = priors::sr::make_sr_net(args.model, args.weights, args.scale);
   ItemPace pace(jobs.size());
   for (size_t i = 0; i < jobs.size(); ++i) {
     const auto [width, height] = upscale_one(*net, args, jobs[i]);
     fmt::print("[{}/{}] {} {}x{} -> {} {}x{} ({})\n", i + 1, jobs.size(), jobs[i].input.string(),
-               width, height, jobs[i].output.string(), width * args.scale, height * args.scale,
+               width, height, jobs[i].outputs[0].string(), width * args.scale, height * args.scale,
                pace.finished(i + 1));
     std::fflush(stdout);
   }
@@ -140,7 +106,9 @@ void add_upscale_command(CLI::App& app) {
   add_tile_options(*command, args->tiles);
   add_gray_background_option(*command, args->background);
   command->add_option("input", args->input, "Image or folder of images")->required();
-  command->add_option("output", args->output, "PNG file, or folder for a folder input")
+  command
+      ->add_option("output", args->output,
+                   "PNG file, or a folder: for a folder input, or an existing one for an image")
       ->required()
       ->check(kNonEmptyPath);
   add_device_option(*command, args->device);

@@ -11,6 +11,14 @@
 
 namespace iesrgs {
 
+// The path as the file system resolves it (links, "..", one folder named two ways), for telling
+// whether two paths name one file; as given, made absolute, when it cannot be resolved.
+inline std::filesystem::path resolved_path(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
+  return ec ? std::filesystem::absolute(path) : canonical;
+}
+
 // The path an environment variable holds; none when it is unset or empty.
 inline std::optional<std::filesystem::path> env_path(const char* variable) {
   const char* value = std::getenv(variable);

@@ -1,31 +1,15 @@
 #include "priors/depth/depth_files.hpp"
 
-#include <set>
 #include <string>
 
-#include "core/error.hpp"
 #include "io/image.hpp"
+#include "io/image_jobs.hpp"
 #include "io/npy.hpp"
 #include "priors/depth/depth_preview.hpp"
 
 namespace iesrgs::priors::depth {
 
-namespace {
-
 namespace fs = std::filesystem;
-
-// Two images with one stem (a.png, a.jpg), or an output folder that is the input one, would
-// otherwise overwrite results or inputs without a word.
-void check_names_unique(const std::vector<DepthJob>& jobs) {
-  std::set<fs::path> taken;
-  for (const DepthJob& job : jobs) taken.insert(fs::weakly_canonical(job.image));
-  for (const DepthJob& job : jobs)
-    for (const fs::path& output : {job.npy, job.preview})
-      if (!taken.insert(fs::weakly_canonical(output)).second)
-        fail_file(output, "would be written twice or overwrite an input image");
-}
-
-}  // namespace
 
 DepthJob depth_job(const fs::path& image, fs::path npy) {
   fs::path preview = npy;
@@ -34,17 +18,13 @@ DepthJob depth_job(const fs::path& image, fs::path npy) {
 }
 
 std::vector<DepthJob> plan_depth_jobs(const fs::path& in, const fs::path& out) {
+  std::vector<ImageJob> planned = plan_image_jobs(in, out, ".npy", "depth");
   std::vector<DepthJob> jobs;
-  if (fs::is_directory(in)) {
-    for (const fs::path& image : image_files_in(in)) {
-      jobs.push_back(depth_job(image, out / image.filename().replace_extension(".npy")));
-    }
-  } else {
-    if (!fs::exists(in)) fail_file(in, "no such image or folder");
-    if (out.extension() != ".npy") fail_file(out, "the output of a single image must end in .npy");
-    jobs.push_back(depth_job(in, out));
+  for (ImageJob& job : planned) {
+    jobs.push_back(depth_job(job.input, job.outputs[0]));
+    job.outputs.push_back(jobs.back().preview);
   }
-  check_names_unique(jobs);
+  refuse_overwrites(planned);
   return jobs;
 }
 

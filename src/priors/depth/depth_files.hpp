@@ -17,11 +17,8 @@ struct DepthJob {
 // The job writing `npy` and "<npy stem>_preview.png" beside it for `image`.
 DepthJob depth_job(const std::filesystem::path& image, std::filesystem::path npy);
 
-// `in` an image file: one job writing `out` (which must end in .npy) and "<out stem>_preview.png"
-// beside it. `in` a folder: one job per PNG or JPEG file directly inside it, by name, writing
-// "<out>/<image stem>.npy" and "<out>/<image stem>_preview.png". Throws Error naming the path
-// when `in` is missing or holds no image, when `out` lacks .npy, or when two outputs or an output
-// and an input would share a name.
+// plan_image_jobs with .npy results, each with "<npy stem>_preview.png" beside it. Throws Error
+// naming the path as plan_image_jobs and refuse_overwrites do.
 std::vector<DepthJob> plan_depth_jobs(const std::filesystem::path& in,
                                       const std::filesystem::path& out);
 

@@ -35,6 +35,8 @@ TEST(DepthFiles, SingleImageWritesBesideTheNpy) {
   ASSERT_EQ(jobs.size(), 1u);
   EXPECT_EQ(jobs[0].npy, dir / "photo.npy");
   EXPECT_EQ(jobs[0].preview, dir / "photo_preview.png");
+  write_text(dir / "out" / "notes.txt", "x");  // an existing folder takes <stem>.npy
+  EXPECT_EQ(plan_depth_jobs(dir / "photo.png", dir / "out")[0].npy, dir / "out" / "photo.npy");
 }
 
 TEST(DepthFiles, BadPlansNameThePath) {
@@ -48,13 +50,16 @@ TEST(DepthFiles, BadPlansNameThePath) {
   EXPECT_EQ(error_message([&] { plan_depth_jobs(dir / "nowhere", dir / "o.npy"); }),
             (dir / "nowhere").string() + ": no such image or folder");
   EXPECT_EQ(error_message([&] { plan_depth_jobs(dir / "photo.png", dir / "photo.png"); }),
-            (dir / "photo.png").string() + ": the output of a single image must end in .npy");
+            (dir / "photo.png").string() +
+                ": depth writes .npy files: name the output .npy, or give an existing folder");
   EXPECT_EQ(error_message([&] { plan_depth_jobs(dir / "empty", dir / "out"); }),
             (dir / "empty").string() + ": no PNG or JPEG images in this folder");
   EXPECT_TRUE(contains(error_message([&] { plan_depth_jobs(dir / "twins", dir / "out"); }),
-                       (dir / "out" / "a.npy").string() + ": would be written twice"));
+                       (dir / "out" / "a.npy").string() + ": would be written twice, for " +
+                           (dir / "twins" / "a.jpg").string() + " and for " +
+                           (dir / "twins" / "a.png").string()));
   EXPECT_TRUE(contains(error_message([&] { plan_depth_jobs(dir / "clash", dir / "clash"); }),
-                       (dir / "clash" / "a_preview.png").string() + ": would be written twice"));
+                       (dir / "clash" / "a_preview.png").string() + ": is an input image"));
 }
 
 TEST(DepthFiles, OutputsHoldTheRawValuesAndAPreview) {
