@@ -57,6 +57,8 @@ void read_weight_group(const json& group, const fs::path& folder, Weights& weigh
     const size_t bytes = *count * sizeof(float);
     torch::Tensor tensor = torch::empty(shape, torch::kFloat);
     if (bytes) std::memcpy(tensor.data_ptr(), reader.take(bytes).data(), bytes);
+    if (!torch::isfinite(tensor).all().item<bool>())
+      throw FormatError(fmt::format("weight '{}' holds non-finite values (NaN or infinity)", name));
     weights[name] = tensor;
   }
   if (reader.remaining()) throw FormatError("weight shards hold more data than the manifest lists");

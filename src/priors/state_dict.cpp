@@ -249,6 +249,9 @@ void load_state_dict(torch::nn::Module& module, const StateDict& weights, const 
     if (source.sizes() != target.sizes())
       fail_file(file, fmt::format("'{}' has shape {} in the file but {} in the model", name,
                                   fmt::streamed(source.sizes()), fmt::streamed(target.sizes())));
+    // Damage a CRC cannot see (a file saved after training diverged) would blacken every output.
+    if (source.is_floating_point() && !torch::isfinite(source).all().item<bool>())
+      fail_file(file, fmt::format("'{}' holds non-finite values (NaN or infinity)", name));
   }
   const torch::NoGradGuard no_grad;
   for (auto& [name, target] : targets) target.copy_(weights.at(name));

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "io/atomic_file.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
@@ -102,6 +104,12 @@ TEST(StateDict, StrictLoadNamesTheFirstBadEntry) {
   misshaped["conv.bias"] = torch::zeros({5});
   EXPECT_EQ(error_message([&] { load_state_dict(model, misshaped, file); }),
             file.string() + ": 'conv.bias' has shape [5] in the file but [4] in the model");
+
+  StateDict diverged = weights;
+  diverged["bn.running_var"] = weights.at("bn.running_var").clone();
+  diverged["bn.running_var"][2] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(error_message([&] { load_state_dict(model, diverged, file); }),
+            file.string() + ": 'bn.running_var' holds non-finite values (NaN or infinity)");
 }
 
 struct SharedCheckpoint {

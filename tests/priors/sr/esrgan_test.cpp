@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
@@ -89,6 +90,13 @@ TEST(KerasModel, NamesTheProblemWithABrokenModel) {
                          read_file(dir / "group1-shard2of2.bin") + "x");
             }),
             "weight shards hold more data than the manifest lists");
+  EXPECT_EQ(load_error([](json&, const TempDir& dir) {
+              std::string shard = read_file(dir / "group1-shard1of2.bin");
+              const float nan = std::numeric_limits<float>::quiet_NaN();
+              shard.replace(0, sizeof nan, reinterpret_cast<const char*>(&nan), sizeof nan);
+              write_text(dir / "group1-shard1of2.bin", shard);
+            }),
+            "weight 'F_1/kernel' holds non-finite values (NaN or infinity)");
 }
 
 TEST(KerasModel, NamesAMissingShardOrInvalidJson) {
