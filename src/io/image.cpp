@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string_view>
@@ -14,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/paths.hpp"
 #include "io/atomic_file.hpp"
+#include "io/mapped_file.hpp"
 
 namespace iesrgs {
 
@@ -32,7 +34,33 @@ std::string decode_problem() {
   const char* reason = stbi_failure_reason();
   if (reason && std::string_view(reason) == "can't fopen")
     return std::string("cannot be opened: ") + std::strerror(open_error);
-  return std::string("not a readable PNG/JPEG (") + (reason ? reason : "unknown reason") + ")";
+  return std::string("not a readable PNG/JPEG (") +
+         (reason && *reason ? reason : "damaged or truncated") + ")";
+}
+
+uint32_t big_endian32(std::string_view bytes, size_t at) {
+  return uint32_t(uint8_t(bytes[at])) << 24 | uint32_t(uint8_t(bytes[at + 1])) << 16 |
+         uint32_t(uint8_t(bytes[at + 2])) << 8 | uint32_t(uint8_t(bytes[at + 3]));
+}
+
+// stb decodes a PNG without checking its chunks' CRCs, so a flipped byte of the pixel data would
+// decode into other pixels without a word; libpng and PIL refuse such a file, and so does this.
+// Chunks cut off by the end of the file are left to the decoder, which names the truncation.
+void check_png_crcs(std::string_view bytes, const fs::path& path) {
+  constexpr std::string_view kSignature = "\x89PNG\r\n\x1a\n";
+  if (bytes.substr(0, kSignature.size()) != kSignature) return;
+  for (size_t at = kSignature.size(); at + 12 <= bytes.size();) {
+    const uint64_t length = big_endian32(bytes, at);
+    if (at + 12 + length > bytes.size()) return;
+    const std::string_view typed = bytes.substr(at + 4, 4 + length);  // the type and the data
+    const uint32_t crc =
+        uint32_t(crc32_z(0, reinterpret_cast<const Bytef*>(typed.data()), typed.size()));
+    if (crc != big_endian32(bytes, at + 8 + length))
+      fail_file(path, fmt::format("damaged: its PNG chunk {} at byte {} fails its CRC",
+                                  typed.substr(0, 4), at));
+    if (typed.substr(0, 4) == "IEND") return;
+    at += 12 + length;
+  }
 }
 
 void append_png_chunk(std::string& png, const char* type, const std::string& payload) {
@@ -122,9 +150,16 @@ ImageHeader read_image_header(const fs::path& path) {
 
 Image8 read_image8(const fs::path& path) {
   require_readable(path);
+  const MappedFile file(path);
+  const std::string_view bytes = file.bytes();
+  check_png_crcs(bytes, path);
+  if (bytes.size() > size_t(std::numeric_limits<int>::max()))
+    fail_file(path, "not a readable PNG/JPEG (over 2 GiB)");
   int w = 0, h = 0, c = 0;
-  std::unique_ptr<stbi_uc, void (*)(void*)> pixels(stbi_load(path.c_str(), &w, &h, &c, 0),
-                                                   stbi_image_free);
+  std::unique_ptr<stbi_uc, void (*)(void*)> pixels(
+      stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size()), &w,
+                            &h, &c, 0),
+      stbi_image_free);
   if (!pixels) fail_file(path, decode_problem());
   Image8 image(w, h, c);
   std::memcpy(image.data.data(), pixels.get(), image.data.size());

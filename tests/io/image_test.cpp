@@ -113,5 +113,23 @@ TEST(Image, CorruptFilesAreNamed) {
   }
 }
 
+// A flipped byte of the pixel data still inflates, into other pixels: the chunk's CRC tells.
+TEST(Image, APngWhoseDataFailsItsCrcIsDamaged) {
+  TempDir dir;
+  write_png(dir / "ok.png", gradient(64, 64, 3));
+  std::string png = read_file(dir / "ok.png");
+  const size_t data = png.find("IDAT");
+  png[data + 40] = char(png[data + 40] ^ 0x55);
+  write_text(dir / "flipped.png", png);
+  EXPECT_EQ(error_message([&] { read_image8(dir / "flipped.png"); }),
+            (dir / "flipped.png").string() + ": damaged: its PNG chunk IDAT at byte " +
+                std::to_string(data - 4) + " fails its CRC");
+  const size_t end = png.find("IEND");
+  write_text(dir / "no_end.png", read_file(dir / "ok.png").substr(0, end - 4));
+  // stb wants the end chunk, and says nothing of why: the message does.
+  EXPECT_EQ(error_message([&] { read_image8(dir / "no_end.png"); }),
+            (dir / "no_end.png").string() + ": not a readable PNG/JPEG (damaged or truncated)");
+}
+
 }  // namespace
 }  // namespace iesrgs
