@@ -79,13 +79,8 @@ train::TrainConfig resumed_config(const TrainArgs& args, const std::filesystem::
   }
   spdlog::info("resuming with the config saved in {}", saved.string());
   if (!args.run_options_given) return config;
-  const nlohmann::json kept = train::to_json(config),
-                       asked = train::to_json(requested_config(args, config));
-  std::vector<std::string> changes;
-  for (const auto& item : kept.items())
-    if (asked[item.key()] != item.value())
-      changes.push_back(fmt::format("{} {} instead of {}", item.key(), asked[item.key()].dump(),
-                                    item.value().dump()));
+  const std::vector<std::string> changes =
+      train::config_changes(config, requested_config(args, config));
   if (!changes.empty())
     fail_file(saved, fmt::format(
                          "--resume continues this run, and the options given would change it ({}); "
@@ -115,6 +110,8 @@ void run_train(const TrainArgs& args) {
                                ? train::Trainer::resumed(config, std::move(setup))
                                : train::Trainer(config, std::move(setup),
                                                 train::initial_model(scene, config, args.init_ply));
+  if (args.resume)
+    fmt::print("resuming {} from {}\n", trainer.resume_point(), trainer.checkpoint_path().string());
   // Only now that the scene and the starting model have loaded: a folder holding a config but no
   // checkpoint would make --resume fail on that instead of the real problem.
   if (!args.resume) {

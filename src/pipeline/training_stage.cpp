@@ -19,7 +19,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // What a training stage's record must match: its inputs and its whole training config.
-nlohmann::json stage_identity(const nlohmann::json& params, const train::TrainConfig& config) {
+nlohmann::json training_stage_identity(const nlohmann::json& params,
+                                       const train::TrainConfig& config) {
   return {{"stage", params}, {"training", train::to_json(config)}};
 }
 
@@ -34,7 +35,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
                                const train::TrainConfig& config, train::TrainerSetup setup,
                                const std::function<gs::GaussianModel()>& initial_model) {
   const fs::path dir = setup.output_dir;
-  const nlohmann::json identity = stage_identity(params, config);
+  const nlohmann::json identity = training_stage_identity(params, config);
   // The recorded time of a finished stage whose model is made again from its final checkpoint:
   // the later stages that learnt from the model are keyed on it.
   std::optional<double> finished_seconds;
@@ -62,9 +63,9 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   record_stage(dir, identity, false, 0);
   std::optional<train::Trainer> trainer;
   if (resumable) {
-    fmt::print("{}: resuming from {}\n", name, checkpoint.string());
     try {
       trainer.emplace(train::Trainer::resumed(config, setup));
+      fmt::print("{}: resuming {} from {}\n", name, trainer->resume_point(), checkpoint.string());
     } catch (const Error& e) {
       // A checkpoint this stage cannot continue (damaged, or not its own) would stop every rerun.
       fmt::print("{}: {}; training it again from the start\n", name, e.what());
@@ -90,7 +91,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
 
 bool training_stage_current(const fs::path& dir, const nlohmann::json& params,
                             const train::TrainConfig& config) {
-  return model_finished(dir, stage_identity(params, config));
+  return model_finished(dir, training_stage_identity(params, config));
 }
 
 }  // namespace iesrgs::pipeline

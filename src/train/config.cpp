@@ -1,5 +1,6 @@
 #include "train/config.hpp"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -125,6 +126,16 @@ nlohmann::json to_json(const TrainConfig& config) {
   nlohmann::json json = nlohmann::json::object();
   visit_fields(config, [&](const char* key, const auto& field) { json[key] = field; });
   return json;
+}
+
+std::vector<std::string> config_changes(const TrainConfig& from, const TrainConfig& to) {
+  const nlohmann::json before = to_json(from), after = to_json(to);
+  std::vector<std::string> changes;
+  for (const auto& item : before.items())
+    if (after[item.key()] != item.value())
+      changes.push_back(fmt::format("{} {} instead of {}", item.key(), after[item.key()].dump(),
+                                    item.value().dump()));
+  return changes;
 }
 
 void apply_json(TrainConfig& config, const nlohmann::json& json, const std::string& origin) {

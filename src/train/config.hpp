@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "gs/optimizer.hpp"
 #include "loss/photometric.hpp"
@@ -64,6 +65,8 @@ TrainConfig make_preset(const std::string& name, int64_t iterations = 0);
 void rescale_schedule(TrainConfig& config, int64_t iterations);
 
 nlohmann::json to_json(const TrainConfig& config);
+// The fields in which `to` differs from `from`, each as "key <to's value> instead of <from's>".
+std::vector<std::string> config_changes(const TrainConfig& from, const TrainConfig& to);
 // Overrides the fields present in `json`; unknown keys and wrong types are errors naming `origin`.
 void apply_json(TrainConfig& config, const nlohmann::json& json, const std::string& origin);
 // "key=value" overrides from the command line (value parsed as JSON, else taken as a string),

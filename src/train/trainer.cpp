@@ -1,6 +1,5 @@
 #include "train/trainer.hpp"
 
-#include <fmt/core.h>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
@@ -50,7 +49,7 @@ bool finite(const torch::Tensor& values) {
   return !values.defined() || torch::isfinite(values).all().item<bool>();
 }
 
-bool all_finite(const gs::GaussianModel& model) {
+bool model_is_finite(const gs::GaussianModel& model) {
   for (int p = 0; p < gs::kParamCount; ++p)
     if (!finite(model.param(gs::Param(p)))) return false;
   return true;
@@ -58,7 +57,7 @@ bool all_finite(const gs::GaussianModel& model) {
 
 // Everything a checkpoint restores that the next step computes with.
 bool restored_state_finite(const gs::GaussianModel& model, const gs::GaussianOptimizer& optimizer) {
-  if (!all_finite(model) || !finite(model.filter_3d)) return false;
+  if (!model_is_finite(model) || !finite(model.filter_3d)) return false;
   for (int p = 0; p < gs::kParamCount; ++p) {
     const gs::AdamMoments& moments = optimizer.moments(gs::Param(p));
     if (!finite(moments.first) || !finite(moments.second)) return false;
@@ -116,7 +115,7 @@ Trainer::Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianMode
 
 void Trainer::save_checkpoint() {
   // Never replace a good checkpoint with a broken model.
-  if (!all_finite(model_)) fail_diverged(iteration_, last_loss_);
+  if (!model_is_finite(model_)) fail_diverged(iteration_, last_loss_);
   std::ostringstream view_rng;
   view_rng << view_rng_;
   torch::Tensor torch_rng;
@@ -133,7 +132,8 @@ void Trainer::save_checkpoint() {
        {"seconds", torch::tensor(training_seconds(), torch::kFloat64)},
        {"loss", torch::tensor(last_loss_, torch::kFloat64)},
        {"test_psnr", torch::tensor(last_test_psnr_.value_or(0), torch::kFloat64)},
-       {"background", background_tensor()}});
+       {"background", background_tensor()},
+       {"config", bytes_tensor(to_json(config_).dump())}});
   checkpoint_iteration_ = iteration_;
 }
 
@@ -154,9 +154,9 @@ void Trainer::load_checkpoint() {
   if (!std::filesystem::exists(path))
     fail_file(path, "no checkpoint to resume from (train without --resume first)");
   require_same_cameras();  // before reading a checkpoint that may not fit these views
-  gs::CheckpointExtras extras{{"iteration", {}}, {"view_rng", {}}, {"torch_rng", {}},
-                              {"seconds", {}},   {"loss", {}},     {"test_psnr", {}},
-                              {"background", {}}};
+  gs::CheckpointExtras extras{{"iteration", {}},  {"view_rng", {}}, {"torch_rng", {}},
+                              {"seconds", {}},    {"loss", {}},     {"test_psnr", {}},
+                              {"background", {}}, {"config", {}}};
   gs::load_training_state(path, model_, *optimizer_, stats_, &extras);  // onto the CPU
   // A model that diverged is never saved, so these were damaged or written by another program;
   // training from them would only diverge again, blaming the images.
@@ -197,6 +197,7 @@ void Trainer::restore_extras(gs::CheckpointExtras& extras) {
                                 fmt::join(background.data_ptr<float>(),
                                           background.data_ptr<float>() + background.numel(), ","),
                                 fmt::join(setup_.background, ",")));
+  require_own_config(extras["config"]);
   const double iteration = stored("iteration");
   if (!(iteration >= 0 && iteration <= double(config_.iterations)))
     fail_file(path, fmt::format("stored at iteration {}, outside the 0..{} iterations of the run's "
@@ -213,6 +214,30 @@ void Trainer::restore_extras(gs::CheckpointExtras& extras) {
   auto generator = at::detail::getDefaultCPUGenerator();
   std::lock_guard<std::mutex> lock(generator.mutex());
   generator.set_state(extras["torch_rng"]);
+}
+
+std::string Trainer::resume_point() const {
+  return fmt::format(
+      "at iteration {} of {}{}", iteration_, config_.iterations,
+      iteration_ == config_.iterations ? " (finished: writing its outputs again)" : "");
+}
+
+void Trainer::require_own_config(const torch::Tensor& stored) const {
+  if (!stored.defined()) return;  // written before checkpoints kept their config
+  const std::filesystem::path path = checkpoint_path();
+  const nlohmann::json json = nlohmann::json::parse(tensor_bytes(stored), nullptr, false);
+  TrainConfig saved;
+  try {
+    apply_json(saved, json, "its config");
+  } catch (const Error& e) {
+    fail_file(path, fmt::format("not a readable training checkpoint ({})", e.what()));
+  }
+  // Copied from another run, say: its model would go on under this run's name and config.
+  const std::vector<std::string> changes = config_changes(saved, config_);
+  if (!changes.empty())
+    fail_file(path, fmt::format("written by a run of another config: this run has {}; resume "
+                                "in the folder it comes from, or train without --resume",
+                                fmt::join(changes, ", ")));
 }
 
 void Trainer::require_same_cameras() const {
@@ -375,7 +400,7 @@ TrainSummary Trainer::run() {
     const bool last = iteration_ == config_.iterations;
     // The parameters are checked after the optimizer step, and not every step (a reduction over
     // the whole model): a divergence shows within 100 iterations and never reaches the outputs.
-    if ((iteration_ % 100 == 0 || last) && !all_finite(model_))
+    if ((iteration_ % 100 == 0 || last) && !model_is_finite(model_))
       fail_diverged(iteration_, last_loss_);
     std::optional<double> test_psnr;
     if (!setup_.test_views.empty() && config_.test_every > 0 &&

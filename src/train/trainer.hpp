@@ -89,6 +89,8 @@ class Trainer {
   // On the training device (core/device.hpp).
   const gs::GaussianModel& model() const { return model_; }
   const std::array<float, 3>& background() const { return setup_.background; }
+  // "at iteration N of M", and whether the run had finished there: what a resume continues.
+  std::string resume_point() const;
   std::filesystem::path checkpoint_path() const {
     return train::checkpoint_path(setup_.output_dir);
   }
@@ -101,7 +103,8 @@ class Trainer {
   void restore_extras(gs::CheckpointExtras& extras);  // the iteration, random states, ...
   // The training cameras as 3DGS saves them for viewers; also what --resume compares against.
   std::filesystem::path cameras_path() const { return setup_.output_dir / "cameras.json"; }
-  void require_same_cameras() const;  // as cameras_path() holds them
+  void require_same_cameras() const;                           // as cameras_path() holds them
+  void require_own_config(const torch::Tensor& stored) const;  // the config a checkpoint keeps
   torch::Tensor background_tensor() const;
   double step(int64_t iteration);  // one optimizer step; returns the loss
   std::vector<int> pick_views();

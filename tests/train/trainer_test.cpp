@@ -332,6 +332,22 @@ TEST_F(TrainerTest, TamperedCheckpointsAreRefused) {
                                 "cameras.json: missing beside the checkpoint"));
 }
 
+// A checkpoint copied from a run of another config (another seed, say) is not this run's.
+TEST_F(TrainerTest, ACheckpointOfAnotherConfigIsRefused) {
+  TempDir out;
+  TrainConfig c = config();
+  c.iterations = 4;
+  Trainer(c, setup(out.path()), initial()).run();
+  TrainConfig other = c;
+  other.seed = c.seed + 1;
+  EXPECT_TRUE(testing::contains(
+      error_message([&] { Trainer::resumed(other, setup(out.path())); }),
+      "checkpoint.pt: written by a run of another config: this run has seed " +
+          std::to_string(other.seed) + " instead of " + std::to_string(c.seed) + "; resume"));
+  EXPECT_EQ(Trainer::resumed(c, setup(out.path())).resume_point(),
+            "at iteration 4 of 4 (finished: writing its outputs again)");
+}
+
 // Checkpoints of older versions hold only the required extras; they resume as before.
 TEST_F(TrainerTest, CheckpointWithoutTheOptionalExtrasResumes) {
   TempDir out;
