@@ -154,6 +154,27 @@ class GroundTruth {
   std::vector<std::string> names_;  // in the split's or the folder's order
 };
 
+// The report's path without .json and .csv. Never over the renders' record (eval's own check of
+// them) nor into a scene's own folder, where it could replace the scene's transforms.
+std::filesystem::path report_base(const EvalArgs& args) {
+  namespace fs = std::filesystem;
+  fs::path base = args.output.empty() ? fs::path(args.renders) / "metrics" : fs::path(args.output);
+  // A folder given as the output holds the report under the default name, not as ".json".
+  if (!base.has_filename() || fs::is_directory(base)) base /= "metrics";
+  // The report is two files, so a path naming one of them names both.
+  if (base.extension() == ".json" || base.extension() == ".csv") base.replace_extension();
+  if (resolved_path(fs::path(base).concat(".json")) ==
+      resolved_path(fs::path(args.renders) / "render.json"))
+    fail_file(base, "would replace the renders' render.json; name the report otherwise");
+  const fs::path truth = args.ground_truth;
+  if (is_scene(truth) && resolved_path(base.parent_path()) ==
+                             resolved_path(fs::is_directory(truth) ? truth : truth.parent_path()))
+    fail_file(base,
+              "is in the scene's own folder, whose files the report could replace; write "
+              "it elsewhere (a folder inside it will do)");
+  return base;
+}
+
 void run_eval(const EvalArgs& args) {
   const std::optional<std::array<float, 3>> rendered_over = check_render_record(args);
   SceneArgs scene_args;
@@ -162,6 +183,7 @@ void run_eval(const EvalArgs& args) {
   SceneOptions options = scene_args.resolved();
   // The ground truth over the background the renders were drawn over, as 3DGS scores its renders.
   if (!options.background) options.background = rendered_over;
+  const std::filesystem::path base = report_base(args);
   GroundTruth truth(args, options);
   const eval::LoadedLpips lpips = eval::load_default_lpips(args.lpips);
   eval::MetricsReport report;
@@ -180,12 +202,6 @@ void run_eval(const EvalArgs& args) {
     if ((i + 1) % 25 == 0 || i + 1 == files.size())
       fmt::print("evaluated {}/{} views\n", i + 1, files.size());
   }
-  std::filesystem::path base = args.output.empty() ? std::filesystem::path(args.renders) / "metrics"
-                                                   : std::filesystem::path(args.output);
-  // A folder given as the output holds the report under the default name, not as ".json".
-  if (!base.has_filename() || std::filesystem::is_directory(base)) base /= "metrics";
-  // The report is two files, so a path naming one of them names both.
-  if (base.extension() == ".json" || base.extension() == ".csv") base.replace_extension();
   // A mean over part of a split is not the split's score: say so, in the report and next to the
   // numbers.
   report.unscored = truth.unscored(report.views);

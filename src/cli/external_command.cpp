@@ -25,6 +25,7 @@ void run_external(const ExternalArgs& args) {
   ViewImages images(scene);
   pipeline::ExternalOptions options = args.options;
   pipeline::resolve_sr_model(options, true);
+  refuse_output_in_scene_folder(args.output, scene);
   const FolderLock lock(args.output);
   pipeline::run_external_stage(scene, images, options, args.output);
 }

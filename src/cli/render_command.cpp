@@ -81,6 +81,7 @@ void run_render(const RenderArgs& args) {
   }
   if (cameras.empty()) fail_file(scene.root, fmt::format("has no {} views", args.split));
   require_render_sizes(cameras, args.scale, scene.root);
+  refuse_output_in_scene_folder(args.output, scene);
   // Two renders into one folder would leave a mix of two models' views.
   const FolderLock lock(args.output);
   const char* mode = model.antialiased ? "antialiased" : "classic";

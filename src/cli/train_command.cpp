@@ -98,6 +98,7 @@ void run_train(const TrainArgs& args) {
   const Scene scene = load_scene(args.scene.path, args.scene.resolved());
   ViewImages images(scene);
   train::TrainerSetup setup = train::scene_setup(scene, images, size_t(config.test_views), out);
+  refuse_output_in_scene_folder(out, scene);
   // Once the scene has loaded, so that a refused input leaves no folder behind.
   const FolderLock lock(out);
   const int width = setup.train_views.front().camera.intrinsics.width;

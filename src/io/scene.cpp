@@ -8,6 +8,7 @@
 #include <map>
 
 #include "core/error.hpp"
+#include "core/paths.hpp"
 #include "io/colmap.hpp"
 #include "io/transforms.hpp"
 
@@ -39,6 +40,10 @@ SceneNormalization Scene::normalization() const {
 }
 
 namespace {
+
+// Training cameras spread over less than this fraction of the scene's depth are nearly at one
+// position (a forward-facing LLFF capture spreads over several percent).
+constexpr double kNarrowSpread = 0.01;
 
 enum class SceneFormat { None, Blender, Nerfstudio, NerfstudioFile, Colmap };
 
@@ -171,6 +176,17 @@ std::optional<std::string> camera_spread_warning(const Scene& scene) {
       "({:.3g}): views from nearly one position see little parallax, and 3DGS's position "
       "learning rate and densification sizes, which scale with that spread, will be tiny",
       cameras.size(), spread, 100 * spread / depth, depth);
+}
+
+fs::path scene_folder(const Scene& scene) {
+  return fs::is_directory(scene.root) ? scene.root : scene.root.parent_path();
+}
+
+void refuse_output_in_scene_folder(const fs::path& output, const Scene& scene) {
+  if (resolved_path(output) != resolved_path(scene_folder(scene))) return;
+  fail_file(output,
+            "is the scene's own folder, whose files the outputs could replace; write them "
+            "elsewhere (a folder inside it will do)");
 }
 
 Scene load_scene(const fs::path& given_root, const SceneOptions& options) {

@@ -45,6 +45,14 @@ struct SceneOptions {
 // when two cameras of a split share a name, since their outputs would overwrite each other.
 Scene load_scene(const std::filesystem::path& root, const SceneOptions& options = {});
 
+// The folder holding the scene: its root, or the folder of the transforms.json given as the scene.
+std::filesystem::path scene_folder(const Scene& scene);
+
+// Throws Error naming `output` when it is the scene's own folder, where outputs (rgb/, render.json,
+// point_cloud.ply, ...) could replace the scene's own files and a later command would remove them
+// as its own. A folder inside it is fine.
+void refuse_output_in_scene_folder(const std::filesystem::path& output, const Scene& scene);
+
 // Whether load_scene would recognise a format at `path` (a plain folder of images is not a scene).
 bool is_scene(const std::filesystem::path& path);
 
@@ -54,10 +62,6 @@ void require_training_views(const Scene& scene);
 // The same, and also when every training view is taken from one position: nothing to train on.
 // Logs camera_spread_warning's text when there is one.
 void require_trainable_views(const Scene& scene);
-
-// Training cameras spread over less than this fraction of the scene's depth are nearly at one
-// position (a forward-facing LLFF capture spreads over several percent).
-inline constexpr double kNarrowSpread = 0.01;
 
 // A warning when the training cameras are that close together, else nothing.
 std::optional<std::string> camera_spread_warning(const Scene& scene);

@@ -181,6 +181,7 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
     lr_options.downscale *= o_.scale;
   }
   lr_scene_ = load_scene(o_.scene, lr_options);
+  refuse_output_in_scene_folder(o_.output, lr_scene_);
   if (hr_scene_ && any_row([](const RowSpec& row) { return row.oracle_mask; }))
     require_scale_divides(*hr_scene_, lr_scene_, o_.scale);
   require_trainable_views(lr_scene_);

@@ -77,6 +77,21 @@ TEST(Scene, ASplitFileOfANerfSyntheticSceneNamesItsFolder) {
   }
 }
 
+// Renders into the scene's folder would replace a nerfstudio scene's rgb/ images, a trained
+// model its SfM points.
+TEST(Scene, OutputsGoAnywhereButTheScenesOwnFolder) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 3, 1});
+  const Scene scene = load_scene(dir / "scene");
+  EXPECT_EQ(
+      error_message([&] { refuse_output_in_scene_folder(dir / "x" / ".." / "scene", scene); }),
+      (dir / "x" / ".." / "scene").string() +
+          ": is the scene's own folder, whose files the outputs could replace; write them "
+          "elsewhere (a folder inside it will do)");
+  refuse_output_in_scene_folder(dir / "scene" / "renders", scene);
+  refuse_output_in_scene_folder(dir / "renders", scene);
+}
+
 TEST(Scene, ViewsOfDifferentSplitsMayShareAName) {
   TempDir dir;
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 2});
