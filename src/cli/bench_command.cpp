@@ -65,7 +65,7 @@ struct Timing {
   double cpu_ms = 0;   // mean, summed over threads
 };
 
-void apply(const RepeatArgs& repeat) {
+void set_bench_threads(const RepeatArgs& repeat) {
   // Through LibTorch, whose first operation on a thread would otherwise set OpenMP's thread
   // count back to its own.
   if (repeat.threads > 0) torch::set_num_threads(repeat.threads);
@@ -175,7 +175,7 @@ RasterStageTimes time_raster_frame(const raster::GaussianParams<float>& g,
 }
 
 void run_raster_bench(const RasterBenchArgs& args) {
-  apply(args.repeat);
+  set_bench_threads(args.repeat);
   using namespace raster;
   const RasterWorkload w = args.model.empty() ? synthetic_workload(args) : trained_workload(args);
   const RasterCamera<float>& largest =
@@ -221,7 +221,7 @@ void run_raster_bench(const RasterBenchArgs& args) {
 }
 
 void run_ssim_bench(const SsimBenchArgs& args) {
-  apply(args.repeat);
+  set_bench_threads(args.repeat);
   const loss::ImageShape shape{args.height, args.width, 3};
   const std::vector<float> x = loss::benchmark_image(shape, 1), y = loss::benchmark_image(shape, 2);
   std::vector<float> partials(loss::ssim_partials_size(shape)), grad(shape.values());
@@ -245,7 +245,7 @@ void run_ssim_bench(const SsimBenchArgs& args) {
 }
 
 void run_adam_bench(const AdamBenchArgs& args) {
-  apply(args.repeat);
+  set_bench_threads(args.repeat);
   const int64_t n = args.gaussians;
   gs::GaussianModel model = gs::benchmark_model(n);
   int64_t floats = 0;

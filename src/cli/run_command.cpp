@@ -42,7 +42,6 @@ struct RunArgs {
   TrainingArgs internal{"fast", 0, 3, {}};
   TrainingArgs fusion{"fast", 0, 1, {}};
   std::string texture = "masked";
-  std::vector<std::string> rows{"ie-srgs"};
   uint64_t seed = 0;
   std::string device = "auto";
 };
@@ -66,7 +65,6 @@ void run_pipeline(const RunArgs& args, pipeline::StageSelection only) {
   options.internal_config = args.internal.resolve(args.seed);
   options.fusion_config = args.fusion.resolve(args.seed);
   options.weights.texture = loss::parse_texture_guidance(args.texture);
-  options.rows = args.rows;
   options.only = only;
   pipeline::run_ie_srgs(options);
 }
@@ -119,7 +117,7 @@ void add_fusion_options(CLI::App& command, RunArgs& args) {
       ->check(CLI::IsMember({"scene", "internal"}))
       ->capture_default_str();
   command
-      .add_option("--rows", args.rows,
+      .add_option("--rows", o.rows,
                   "Comparison rows, comma-separated: " + pipeline::describe_rows())
       ->delimiter(',')
       ->capture_default_str();

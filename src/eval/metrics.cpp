@@ -15,7 +15,7 @@ namespace iesrgs::eval {
 
 namespace {
 
-void check_pair(const Image& image, const Image& reference) {
+void check_same_shape(const Image& image, const Image& reference) {
   if (image.channels != 3 || reference.channels != 3)
     fail("metrics need RGB images, got {} and {} channels", image.channels, reference.channels);
   if (image.width != reference.width || image.height != reference.height)
@@ -46,7 +46,7 @@ std::string csv_row(const ViewMetrics& m) {
 }  // namespace
 
 double psnr(const Image& image, const Image& reference) {
-  check_pair(image, reference);
+  check_same_shape(image, reference);
   double sum = 0;
   for (size_t i = 0; i < image.data.size(); ++i) {
     const double d = double(image.data[i]) - double(reference.data[i]);
@@ -60,7 +60,7 @@ double psnr_from_mse(double mse) {
 }
 
 double ssim(const Image& image, const Image& reference) {
-  check_pair(image, reference);
+  check_same_shape(image, reference);
   const torch::Tensor x = to_tensor(image), y = to_tensor(reference);  // planar copies
   return loss::ssim<float>(x.data_ptr<float>(), y.data_ptr<float>(), {image.width, image.height, 3},
                            nullptr, nullptr);

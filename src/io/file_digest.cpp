@@ -19,7 +19,7 @@ namespace {
 constexpr uint64_t kFnvOffset = 14695981039346656037ull;
 constexpr uint64_t kFnvPrime = 1099511628211ull;
 
-uint64_t mix(uint64_t hash, uint64_t word) {
+uint64_t fnv_mix(uint64_t hash, uint64_t word) {
   return (hash ^ word) * kFnvPrime;
 }
 
@@ -28,9 +28,9 @@ uint64_t mix_bytes(uint64_t hash, const char* bytes, size_t size) {
   for (; i + 8 <= size; i += 8) {
     uint64_t word;
     std::memcpy(&word, bytes + i, 8);
-    hash = mix(hash, word);
+    hash = fnv_mix(hash, word);
   }
-  for (; i < size; ++i) hash = mix(hash, uint8_t(bytes[i]));
+  for (; i < size; ++i) hash = fnv_mix(hash, uint8_t(bytes[i]));
   return hash;
 }
 
@@ -41,7 +41,7 @@ std::string file_digest(const fs::path& path) {
   if (path.empty() || !fs::is_regular_file(path, ec)) return "-";
   std::ifstream in(path, std::ios::binary);
   if (!in) fail_file(path, "cannot be opened for reading");
-  uint64_t hash = mix(kFnvOffset, fs::file_size(path, ec));
+  uint64_t hash = fnv_mix(kFnvOffset, fs::file_size(path, ec));
   // Whole words per chunk, so that the result does not depend on where chunks end.
   std::vector<char> chunk(size_t(1) << 20);
   while (in) {
@@ -54,7 +54,7 @@ std::string file_digest(const fs::path& path) {
 
 std::string bytes_digest(std::string_view bytes) {
   return fmt::format("{:016x}",
-                     mix_bytes(mix(kFnvOffset, bytes.size()), bytes.data(), bytes.size()));
+                     mix_bytes(fnv_mix(kFnvOffset, bytes.size()), bytes.data(), bytes.size()));
 }
 
 std::string directory_digest(const fs::path& dir) {

@@ -78,34 +78,41 @@ FolderLock::FolderLock(const fs::path& folder) {
   for (fs::path missing = folder; !missing.empty() && !fs::exists(missing, ec);
        missing = missing.parent_path())
     created_.push_back(missing);
+  try {
+    take(folder);
+  } catch (...) {
+    release();  // the destructor does not run for a constructor that throws
+    throw;
+  }
+}
+
+FolderLock::~FolderLock() {
+  release();
+}
+
+void FolderLock::take(const fs::path& folder) {
+  std::error_code ec;
   fs::create_directories(folder, ec);
   if (ec) fail_file(folder, "cannot create the output folder (" + ec.message() + ")");
   // A directory can be locked itself: no lock file is left among the outputs.
   fd_ = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0)
     fail_file(folder, std::string("cannot open the output folder (") + std::strerror(errno) + ")");
-  if (!lock_exclusively(fd_)) {
-    ::close(fd_);
-    fd_ = -1;
+  if (!lock_exclusively(fd_))
     fail_file(folder,
-              "in use by another iesrgs process; wait for it to end (or stop it) before writing "
-              "to this folder again");
-  }
-  try {
-    refuse_around_held_folder(folder);
-  } catch (...) {
-    ::close(fd_);
-    throw;
-  }
+              "in use by another process (an iesrgs command, say); wait for it to end (or "
+              "stop it) before writing to this folder again");
+  refuse_around_held_folder(folder);
   remove_stale_temporaries(folder);
 }
 
-FolderLock::~FolderLock() {
+void FolderLock::release() {
   // Still holding the lock, so that no other process starts writing in between.
   std::error_code ec;
   for (const fs::path& folder : created_)
     if (!fs::remove(folder, ec)) break;  // not empty: this and every parent stay
   if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
 }
 
 }  // namespace iesrgs

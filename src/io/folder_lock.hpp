@@ -22,6 +22,9 @@ class FolderLock {
   FolderLock& operator=(const FolderLock&) = delete;
 
  private:
+  void take(const std::filesystem::path& folder);  // creates, locks and checks the folder
+  void release();
+
   int fd_ = -1;
   std::vector<std::filesystem::path> created_;  // the folder first, then its new parents
 };

@@ -13,7 +13,8 @@ namespace iesrgs {
 
 namespace {
 
-bool all_finite(const std::vector<float>& values, size_t from, size_t count, bool exponentiated) {
+bool values_are_finite(const std::vector<float>& values, size_t from, size_t count,
+                       bool exponentiated) {
   return std::all_of(values.begin() + from, values.begin() + from + count,
                      [&](float v) { return std::isfinite(exponentiated ? std::exp(v) : v); });
 }
@@ -21,11 +22,11 @@ bool all_finite(const std::vector<float>& values, size_t from, size_t count, boo
 // Why Gaussian i of `cloud` cannot be drawn, or nullptr when it can.
 const char* undrawable(const SplatCloud& cloud, size_t i) {
   const size_t rest = cloud.sh_rest.size() / cloud.size();
-  if (!all_finite(cloud.positions, 3 * i, 3, false)) return "a non-finite position";
-  if (!all_finite(cloud.log_scales, 3 * i, 3, true))
+  if (!values_are_finite(cloud.positions, 3 * i, 3, false)) return "a non-finite position";
+  if (!values_are_finite(cloud.log_scales, 3 * i, 3, true))
     return "a scale that is no finite float once exponentiated";
-  if (!all_finite(cloud.sh_dc, 3 * i, 3, false) ||
-      !all_finite(cloud.sh_rest, rest * i, rest, false))
+  if (!values_are_finite(cloud.sh_dc, 3 * i, 3, false) ||
+      !values_are_finite(cloud.sh_rest, rest * i, rest, false))
     return "a non-finite colour";
   if (!std::isfinite(cloud.opacity[i])) return "a non-finite opacity";
   const double norm = quaternion_norm(&cloud.rotations[4 * i]);

@@ -40,7 +40,7 @@ auto with_scalar_type(const at::Tensor& tensor, Body&& body) {
   return tensor.scalar_type() == at::kDouble ? body(double{}) : body(float{});
 }
 
-void check_pair(const char* what, const at::Tensor& value, const at::Tensor& target) {
+void check_loss_inputs(const char* what, const at::Tensor& value, const at::Tensor& target) {
   if (!value.defined() || !target.defined()) fail("{}: undefined tensor", what);
   if (value.device() != target.device())
     fail("{}: the target is on {}, the value on {}", what, c10::str(target.device()),
@@ -219,14 +219,14 @@ class GuidedTextureFunction : public torch::autograd::Function<GuidedTextureFunc
 }  // namespace
 
 SsimTensors ssim_autograd(const at::Tensor& x, const at::Tensor& y) {
-  check_pair("ssim", x, y);
+  check_loss_inputs("ssim", x, y);
   require_ssim_kernel_for(x, "ssim");
   const variable_list out = SsimFunction::apply(x, y);
   return {out[0], out[1]};
 }
 
 at::Tensor pearson_autograd(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
-  check_pair("pearson", a, b);
+  check_loss_inputs("pearson", a, b);
   if (mask.defined() && mask.sizes() != a.sizes())
     fail("pearson: mask must have shape {}, not {}", c10::str(a.sizes()), c10::str(mask.sizes()));
   if (mask.defined() && mask.device() != a.device())
@@ -258,8 +258,8 @@ at::Tensor pearson_from_ops(const at::Tensor& a, const at::Tensor& b, const at::
 
 at::Tensor covered_depth_l1_autograd(const at::Tensor& depth, const at::Tensor& alpha,
                                      const at::Tensor& reference) {
-  check_pair("covered depth L1", depth, reference);
-  check_pair("covered depth L1 (alpha)", depth, alpha.detach());
+  check_loss_inputs("covered depth L1", depth, reference);
+  check_loss_inputs("covered depth L1 (alpha)", depth, alpha.detach());
   if (!depth.device().is_cpu())
     return covered_depth_l1_from_ops(depth, alpha, reference);  // the kernel reads host memory
   return CoveredDepthL1Function::apply(depth, alpha, reference);
@@ -276,7 +276,7 @@ at::Tensor covered_depth_l1_from_ops(const at::Tensor& depth, const at::Tensor& 
 
 at::Tensor photometric_autograd(const at::Tensor& render, const at::Tensor& target,
                                 double dssim_weight) {
-  check_pair("photometric loss", render, target);
+  check_loss_inputs("photometric loss", render, target);
   chw_shape(render, "photometric loss");
   if (!render.device().is_cpu()) {
     require_ssim_kernel_for(render, "photometric loss");
@@ -294,8 +294,8 @@ at::Tensor guided_texture_autograd(const at::Tensor& render, const at::Tensor& i
                                    double dssim_weight) {
   if (!internal.defined() && !external.defined())
     fail("guided texture: neither the internal nor the external image is given");
-  if (internal.defined()) check_pair("guided texture (internal)", render, internal);
-  if (external.defined()) check_pair("guided texture (external)", render, external);
+  if (internal.defined()) check_loss_inputs("guided texture (internal)", render, internal);
+  if (external.defined()) check_loss_inputs("guided texture (external)", render, external);
   const auto expected = render.sizes().slice(1);
   if (!internal_share.defined() || internal_share.sizes() != expected ||
       internal_share.scalar_type() != render.scalar_type())

@@ -15,11 +15,11 @@ namespace {
 
 constexpr const char* kGuidanceNames[] = {"masked", "average", "external", "internal"};
 
-// A float (H, W) tensor holding its own copy of `values`.
+// A float (H, W) tensor holding its own copy of `values`, whose element type is `source_type`.
 template <typename T>
 torch::Tensor map_tensor(const std::vector<T>& values, const ImageShape& shape,
-                         torch::ScalarType type) {
-  return torch::from_blob(const_cast<T*>(values.data()), {shape.height, shape.width}, type)
+                         torch::ScalarType source_type) {
+  return torch::from_blob(const_cast<T*>(values.data()), {shape.height, shape.width}, source_type)
       .clone()
       .to(torch::kFloat);
 }

@@ -55,7 +55,8 @@ torch::Tensor internal_share(TextureGuidance guidance, const torch::Tensor& inte
 // GPU wait for every step.
 struct FusionLossTerms {
   torch::Tensor total;  // differentiable
-  // Unweighted and detached, for logs; undefined when the term is off.
+  // Unweighted and detached, each term's own value (the tests check them one by one); undefined
+  // when the term is off.
   torch::Tensor texture, internal_depth, external_depth;
 };
 

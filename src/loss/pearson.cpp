@@ -21,7 +21,7 @@ bool selected(const uint8_t* mask, size_t i) {
 }
 
 template <typename T>
-Moments moments(const T* a, const T* b, const uint8_t* mask, size_t count) {
+Moments masked_moments(const T* a, const T* b, const uint8_t* mask, size_t count) {
   double sum_a = 0, sum_b = 0;
   int64_t n = 0;
 #pragma omp parallel for reduction(+ : sum_a, sum_b, n)
@@ -55,7 +55,7 @@ Moments moments(const T* a, const T* b, const uint8_t* mask, size_t count) {
 
 template <typename T>
 double pearson_correlation(const T* a, const T* b, const uint8_t* mask, size_t count) {
-  return moments(a, b, mask, count).correlation();
+  return masked_moments(a, b, mask, count).correlation();
 }
 
 // d corr / d a_i = db_i / sqrt(aa bb) - corr da_i / aa; the means' own dependence on a_i drops
@@ -63,7 +63,7 @@ double pearson_correlation(const T* a, const T* b, const uint8_t* mask, size_t c
 template <typename T>
 void pearson_correlation_backward(const T* a, const T* b, const uint8_t* mask, size_t count,
                                   double scale, T* grad_a) {
-  const Moments m = moments(a, b, mask, count);
+  const Moments m = masked_moments(a, b, mask, count);
   if (!m.defined()) return;
   const double along_b = scale / std::sqrt(m.aa * m.bb);
   const double along_a = scale * m.correlation() / m.aa;

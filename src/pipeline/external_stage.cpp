@@ -38,7 +38,7 @@ std::string sr_weights_digest(const ExternalOptions& o) {
 }
 
 // Everything one view's outputs depend on besides the view itself.
-std::string stage_identity(const ExternalOptions& o) {
+std::string external_stage_identity(const ExternalOptions& o) {
   return fmt::format("sr={} x{} tile={}/{} weights={} | depth={} weights={}", o.sr_model, o.scale,
                      o.tiles.tile, o.tiles.overlap, sr_weights_digest(o), o.depth_model,
                      // Without a depth model its weights are unused: naming them changes nothing.
@@ -78,6 +78,33 @@ bool view_cached(const nlohmann::json& record, const std::string& fingerprint,
   return false;
 }
 
+// The external networks, loaded at the first view that needs them: a rerun that finds every view
+// cached reads no weights.
+class ExternalNets {
+ public:
+  explicit ExternalNets(const ExternalOptions& options) : options_(options) {}
+
+  // E_image of `rgb` into view.image, and E_depth of it into view.depth unless the depth model
+  // is none.
+  void compute(const torch::Tensor& rgb, const ExternalView& view) {
+    if (!sr_) {
+      sr_ = priors::sr::make_sr_net(options_.sr_model, options_.sr_weights, options_.scale);
+      depth_ = priors::depth::make_depth_net(options_.depth_model, options_.depth_weights);
+    }
+    write_png(view.image, to_image8(priors::sr::upscale_tiled(*sr_, rgb, options_.tiles)));
+    if (!depth_) return;
+    // Depth of E_image as the model saw it: the 8-bit image written above.
+    const torch::Tensor seen = to_tensor(to_float(read_image8(view.image)));
+    priors::depth::write_depth_outputs(depth_->predict(seen),
+                                       priors::depth::depth_job(view.image, view.depth));
+  }
+
+ private:
+  const ExternalOptions& options_;
+  std::unique_ptr<priors::sr::SrNet> sr_;
+  std::unique_ptr<priors::depth::DepthNet> depth_;
+};
+
 }  // namespace
 
 void resolve_sr_model(ExternalOptions& options, bool announce) {
@@ -89,13 +116,11 @@ void resolve_sr_model(ExternalOptions& options, bool announce) {
 std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& images,
                                              const ExternalOptions& options, const fs::path& dir) {
   if (options.sr_model == "auto") fail("run_external_stage: resolve the SR model first");
-  const std::string stage = stage_identity(options);
+  const std::string stage = external_stage_identity(options);
   const fs::path record_path = dir / "external.json", seconds_path = dir / "seconds.json";
   nlohmann::json record = read_stage_record(record_path);
   nlohmann::json seconds_of = read_stage_record(seconds_path);
-  std::unique_ptr<priors::sr::SrNet> sr;  // loaded only when some view needs it
-  std::unique_ptr<priors::depth::DepthNet> depth;
-  bool loaded = false;
+  ExternalNets nets(options);
 
   const std::vector<const Camera*> cameras = scene.split(Split::Train);
   std::vector<ExternalView> views;
@@ -112,23 +137,10 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
       continue;
     }
     stop_if_interrupted("the external stage");
-    if (!loaded) {
-      sr = priors::sr::make_sr_net(options.sr_model, options.sr_weights, options.scale);
-      depth = priors::depth::make_depth_net(options.depth_model, options.depth_weights);
-      loaded = true;
-    }
     // Forget the view's old entry first: a run killed between the writes below must not leave
     // new files under it, which a later run with the old settings would take for its own.
     if (record.erase(camera.name)) write_file_atomically(record_path, record.dump(1) + "\n");
-    const torch::Tensor upscaled =
-        priors::sr::upscale_tiled(*sr, to_tensor(*images.rgb(camera)), options.tiles);
-    write_png(view.image, to_image8(upscaled));
-    if (depth) {
-      // Depth of E_image as the model saw it: the 8-bit image written above.
-      const torch::Tensor seen = to_tensor(to_float(read_image8(view.image)));
-      priors::depth::write_depth_outputs(depth->predict(seen),
-                                         priors::depth::depth_job(view.image, view.depth));
-    }
+    nets.compute(to_tensor(*images.rgb(camera)), view);
     record[camera.name] = fingerprint;
     write_file_atomically(record_path, record.dump(1) + "\n");
     view.seconds = since_computed.lap();
@@ -149,7 +161,7 @@ std::vector<ExternalView> run_external_stage(const Scene& scene, ViewImages& ima
 
 bool external_stage_current(const Scene& scene, ViewImages& images, const ExternalOptions& options,
                             const fs::path& dir) {
-  const std::string stage = stage_identity(options);
+  const std::string stage = external_stage_identity(options);
   const nlohmann::json record = read_stage_record(dir / "external.json");
   for (const Camera* camera : scene.split(Split::Train))
     if (!view_cached(record, view_fingerprint(stage, images, *camera),

@@ -116,9 +116,11 @@ class Pipeline {
   void warn_if_lpips_unavailable() const;
   RowResult evaluate_row(const RowSpec& row, const gs::GaussianModel& model, const fs::path& dir);
   RowResult run_fusion_row(const RowSpec& row);
-  // Whether the earlier table's `entry` for `row` is what these settings would give.
+  // Whether `entry`, the row's result.json from an earlier run, is what these settings would
+  // give.
   bool row_current(const RowSpec& row, const nlohmann::json& entry, bool internal_current) const;
   bool row_model_cached(const RowSpec& row) const;  // its HR model is trained for these settings
+  fs::path row_dir(const std::string& id) const { return o_.output / "rows" / id; }
   // What this run scores against: the test views' digest and the LPIPS net.
   nlohmann::json evaluation() const;
   void keep_earlier_rows(RunResult& result) const;
@@ -147,8 +149,6 @@ class Pipeline {
   std::optional<eval::LoadedLpips> lpips_;
 };
 
-namespace {
-
 // The mask-oracle row compares the references with the HR truth pixel by pixel, at the LR views'
 // size times the scale: the truth must have that size. (Other rows render the test views at the
 // truth's own size, whatever the scale.)
@@ -166,8 +166,6 @@ void require_scale_divides(const Scene& hr, const Scene& lr, int scale) {
                           low.width * scale, low.height * scale));
   }
 }
-
-}  // namespace
 
 Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(options.rows)) {
   if (o_.scale < 2) fail("--scale must be at least 2, got {}", o_.scale);
@@ -263,8 +261,8 @@ void Pipeline::forget_earlier_results() const {
   for (const char* table : {"results.md", "results.csv", "results.json"})
     remove_earlier_output(o_.output / table, "left by an earlier run");
   const auto forget_row = [this](const std::string& id) {
-    remove_earlier_output(o_.output / "rows" / id / kRowResultFile, "left by an earlier run");
-    mark_render_stale(o_.output / "rows" / id / "test");
+    remove_earlier_output(row_dir(id) / kRowResultFile, "left by an earlier run");
+    mark_render_stale(row_dir(id) / "test");
   };
   if (internal_changes) forget_row("internal");
   if (scoring)
@@ -428,7 +426,7 @@ RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& mo
 
 RowResult Pipeline::run_fusion_row(const RowSpec& row) {
   const loss::FusionWeights weights = row_weights(row);
-  const fs::path dir = o_.output / "rows" / row.id;
+  const fs::path dir = row_dir(row.id);
   FusionSetup setup = fusion_setup(row, weights);
   const FusionSetup diagnostics_setup = std::string(row.id) == "ie-srgs" ? setup : FusionSetup{};
   const StageResult stage =
@@ -548,7 +546,7 @@ RunResult Pipeline::run() {
   for (size_t i = 0; i < rows_.size(); ++i) {
     const RowSpec& row = row_spec(rows_[i]);
     fmt::print("\n== row {}/{} {}: {} ==\n", i + 1, rows_.size(), row.id, row_label(row));
-    const fs::path dir = o_.output / "rows" / row.id;
+    const fs::path dir = row_dir(row.id);
     if (row.source != Source::Internal) {
       const Stopwatch row_watch;
       result.rows.push_back(run_fusion_row(row));
@@ -574,13 +572,13 @@ bool Pipeline::row_current(const RowSpec& row, const nlohmann::json& entry,
   // a later run may have trained the internal model again, or a row, and stopped before writing
   // the table.
   const bool internal = row.source == Source::Internal;
-  const fs::path dir = internal ? o_.output / "internal" : o_.output / "rows" / row.id;
+  const fs::path dir = internal ? o_.output / "internal" : row_dir(row.id);
   if (entry.value("train_seconds", -1.0) != stage_seconds(dir)) return false;
   return internal || row_model_cached(row);
 }
 
 bool Pipeline::row_model_cached(const RowSpec& row) const {
-  return training_stage_current(o_.output / "rows" / row.id, row_params(row, row_weights(row)),
+  return training_stage_current(row_dir(row.id), row_params(row, row_weights(row)),
                                 o_.fusion_config);
 }
 
@@ -602,7 +600,7 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
   if (internal_) internal_current = true;
   for (const std::string& id : expand_rows({"all"})) {
     if (std::find(rows_.begin(), rows_.end(), id) != rows_.end()) continue;
-    const nlohmann::json earlier = read_stage_record(o_.output / "rows" / id / kRowResultFile);
+    const nlohmann::json earlier = read_stage_record(row_dir(id) / kRowResultFile);
     const nlohmann::json scored = earlier.value("evaluation", nlohmann::json());
     const auto same = [&](const char* key) {
       return scored.is_object() && scored.value(key, nlohmann::json()) == result.evaluation[key];

@@ -42,7 +42,8 @@ struct RunOptions {
 };
 
 // Runs the selected stages and writes <output>/results.{json,csv,md} after the rows, keeping the
-// rows of the folder's earlier table that these settings would reuse unchanged.
+// rows an earlier run in the folder scored (their result.json) that these settings would reuse
+// unchanged.
 RunResult run_ie_srgs(const RunOptions& options);
 
 }  // namespace iesrgs::pipeline

@@ -90,6 +90,12 @@ void mark_render_stale(const std::filesystem::path& dir) {
   write_file_atomically(report, record.dump(2) + "\n");
 }
 
+namespace {
+
+// Refuses views too large for the memory before rendering any: the kernel would kill the process
+// partway through. The CPU's alone, which holds every view's outputs and encodes the files: on a
+// GPU the free memory leaves out what LibTorch has cached, and running out there is an error
+// LibTorch reports.
 void require_render_memory(const std::vector<Camera>& cameras, double scale) {
   Intrinsics largest;
   for (const Camera& camera : cameras) {
@@ -99,6 +105,8 @@ void require_render_memory(const std::vector<Camera>& cameras, double scale) {
   require_memory(int64_t(largest.width) * largest.height * kRenderBytesPerPixel,
                  fmt::format("rendering {}x{} views", largest.width, largest.height));
 }
+
+}  // namespace
 
 RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
                          const std::array<float, 3>& background) {
@@ -120,6 +128,8 @@ RenderedViewFiles rendered_view_files(const std::filesystem::path& dir, const st
           dir / "depth" / (name + ".png"), dir / "alpha" / (name + ".png")};
 }
 
+namespace {
+
 void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
                          const RenderedView& view) {
   const RenderedViewFiles files = rendered_view_files(dir, name);
@@ -133,6 +143,8 @@ void write_rendered_view(const std::filesystem::path& dir, const std::string& na
   write_png16(files.depth_png, depth16, width, height);
   write_png(files.alpha, gray_image8(view.alpha));
 }
+
+}  // namespace
 
 double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel& model,
                        const std::vector<Camera>& cameras, const std::array<float, 3>& background,

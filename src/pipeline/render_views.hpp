@@ -27,26 +27,17 @@ RenderedView render_view(const gs::GaussianModel& model, const Camera& camera,
 // Depth PNGs store millimetres-like units: value = depth * kDepthPngScale, clamped to 16 bits.
 constexpr double kDepthPngScale = 1000.0;
 
-// The files write_rendered_view makes for view `name` in `dir`: rgb/<name>.png, depth/<name>.npy
+// The files rendering view `name` into `dir` writes: rgb/<name>.png, depth/<name>.npy
 // and .png, alpha/<name>.png.
 struct RenderedViewFiles {
   std::filesystem::path rgb, depth_npy, depth_png, alpha;
 };
 RenderedViewFiles rendered_view_files(const std::filesystem::path& dir, const std::string& name);
 
-void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
-                         const RenderedView& view);
-
 // An earlier recorded render in `dir` reads as unfinished, so eval refuses it, and eval's report
 // of it goes, until the next recorded render there finishes; its names stay for that render to
 // clear. For a folder whose model is about to change.
 void mark_render_stale(const std::filesystem::path& dir);
-
-// Refuses views too large for the memory before rendering any: the kernel would kill the process
-// partway through. The CPU's alone, which holds every view's outputs and encodes the files: on a
-// GPU the free memory leaves out what LibTorch has cached, and running out there is an error
-// LibTorch reports.
-void require_render_memory(const std::vector<Camera>& cameras, double scale);
 
 // Renders every camera (at `scale` times its resolution) into `dir`, printing progress; returns
 // the mean rendering time in seconds per view, after one untimed warm-up frame.

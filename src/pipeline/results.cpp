@@ -32,7 +32,7 @@ std::string format_metric(const RowResult& row, double value, int decimals) {
 
 // The time of each stage, from `stages` (results.json's), in pipeline order: what the paper's
 // Table 5 reports. A stage reused from the cache counts the time it took when it ran; rows kept
-// from an earlier run's table have none.
+// from an earlier run have none.
 std::string stages_markdown(const RunResult& result) {
   const nlohmann::json& stages = result.stages;
   std::string md = "| stage | time |\n|---|---|\n";

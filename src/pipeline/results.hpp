@@ -1,6 +1,6 @@
 #pragma once
 // A run's table: its rows' scores, training times and rendering speeds, written as results.json,
-// .csv and .md, and the rows of an earlier table read back.
+// .csv and .md, and each scored row's own result.json, from which a later run keeps it.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -18,7 +18,7 @@ struct RowResult {
   bool evaluated = false;
   double train_seconds = 0;       // the row's own HR training (internal only: the LR model's)
   double fps = 0;                 // test-view rendering at HR
-  bool from_earlier_run = false;  // kept from the folder's table, not run by this command
+  bool from_earlier_run = false;  // read from its result.json, not run by this command
 };
 
 struct RunResult {

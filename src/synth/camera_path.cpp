@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include "synth/geometry.hpp"
 #include "synth/random.hpp"
 
 namespace iesrgs::synth {

@@ -347,7 +347,7 @@ TEST(TrainCli, AFolderInUseIsRefused) {
                                      "render " + model + " " + scene + " -o " + out}) {
     const CliRun refused = iesrgs(command);
     EXPECT_EQ(refused.status, 1) << command;
-    EXPECT_TRUE(contains(last_line(refused.output), out + ": in use by another iesrgs process"))
+    EXPECT_TRUE(contains(last_line(refused.output), out + ": in use by another process"))
         << refused.output;
   }
   EXPECT_TRUE(std::filesystem::is_empty(dir / "run"));

@@ -21,7 +21,7 @@ TEST(FolderLock, OneHolderAtATime) {
   std::optional<FolderLock> first(folder);
   EXPECT_TRUE(std::filesystem::is_directory(folder));
   const std::string message = error_message([&] { FolderLock second(folder); });
-  EXPECT_TRUE(contains(message, folder.string() + ": in use by another iesrgs process")) << message;
+  EXPECT_TRUE(contains(message, folder.string() + ": in use by another process")) << message;
   first.reset();
   FolderLock again(folder);
   EXPECT_TRUE(std::filesystem::is_empty(folder));  // no lock file among the outputs

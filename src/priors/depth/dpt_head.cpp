@@ -3,19 +3,17 @@
 #include <fmt/format.h>
 
 #include "priors/depth/dinov2.hpp"
+#include "priors/sr/layers.hpp"
 
 namespace iesrgs::priors::depth {
 
 namespace {
 
+using sr::same_conv;
 using torch::nn::Conv2d;
 using torch::nn::Conv2dOptions;
 
 constexpr int kHiddenChannels = 32;  // fixed in the authors' output convolutions
-
-Conv2d conv3x3(int in, int out, bool bias = true) {
-  return Conv2d(Conv2dOptions(in, out, 3).padding(1).bias(bias));
-}
 
 // Brings the four levels to 4x, 2x, 1x and 1/2x the patch grid.
 std::vector<torch::nn::AnyModule> make_resize_layers(const std::array<int, 4>& channels) {
@@ -38,8 +36,8 @@ std::vector<int64_t> spatial_size(const torch::Tensor& x, int64_t factor = 1) {
 }  // namespace
 
 ResidualConvUnitImpl::ResidualConvUnitImpl(int features)
-    : conv1_(register_module("conv1", conv3x3(features, features))),
-      conv2_(register_module("conv2", conv3x3(features, features))) {}
+    : conv1_(register_module("conv1", same_conv(features, features, 3, true))),
+      conv2_(register_module("conv2", same_conv(features, features, 3, true))) {}
 
 torch::Tensor ResidualConvUnitImpl::forward(const torch::Tensor& x) {
   return conv2_(torch::relu(conv1_(torch::relu(x)))) + x;
@@ -70,15 +68,16 @@ DptHeadImpl::DptHeadImpl(int in_channels, const DptConfig& config)
   for (size_t level = 0; level < 4; ++level)
     layer_rn_.push_back(scratch->register_module(
         fmt::format("layer{}_rn", level + 1),
-        conv3x3(config.out_channels[level], config.features, /*bias=*/false)));
+        same_conv(config.out_channels[level], config.features, 3, /*bias=*/false)));
   for (size_t level = 0; level < 4; ++level)
     refinenets_.push_back(scratch->register_module(fmt::format("refinenet{}", level + 1),
                                                    FeatureFusionBlock(config.features)));
   const int half = config.features / 2;
-  output_conv1_ = scratch->register_module("output_conv1", conv3x3(config.features, half));
+  output_conv1_ =
+      scratch->register_module("output_conv1", same_conv(config.features, half, 3, true));
   output_conv2_ = scratch->register_module(
       "output_conv2",
-      torch::nn::Sequential(conv3x3(half, kHiddenChannels), torch::nn::ReLU(),
+      torch::nn::Sequential(same_conv(half, kHiddenChannels, 3, true), torch::nn::ReLU(),
                             Conv2d(Conv2dOptions(kHiddenChannels, 1, 1)), torch::nn::ReLU()));
 }
 
