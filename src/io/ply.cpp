@@ -387,15 +387,23 @@ SplatCloud allocate(const Header& header, const std::vector<Slot>& slots, int sh
   return cloud;
 }
 
-// Values of an ascii body, whitespace-separated.
+// Values of an ascii body: a line per vertex, as the format has it, so that a value too many or
+// too few on one line is named there instead of shifting every later vertex.
 class AsciiValues {
  public:
   AsciiValues(std::string_view body, const fs::path& name) : body_(body), name_(name) {}
 
+  void begin_vertex(size_t vertex) {
+    pos_ = body_.find_first_not_of(" \t\r\n", pos_);  // blank lines between vertices pass
+    if (pos_ == std::string_view::npos) fail_truncated(vertex);
+  }
+
   double next(size_t vertex, const Property& property) {
-    const size_t start = body_.find_first_not_of(" \t\r\n", pos_);
-    if (start == std::string_view::npos)
-      fail_file(name_, fmt::format("truncated: the data ends at vertex {}", vertex));
+    const size_t start = std::min(body_.find_first_not_of(" \t\r", pos_), body_.size());
+    if (start == body_.size()) fail_truncated(vertex);
+    if (body_[start] == '\n')
+      fail_file(name_, fmt::format("vertex {}: its line ends before property {}", vertex,
+                                   quote_token(property.name)));
     pos_ = std::min(body_.find_first_of(" \t\r\n", start), body_.size());
     const std::string_view token = body_.substr(start, pos_ - start);
     // from_chars takes no leading '+', which C's strtod (and so other PLY writers' readers) do.
@@ -409,7 +417,20 @@ class AsciiValues {
     return value;
   }
 
+  void end_vertex(size_t vertex) {
+    pos_ = std::min(body_.find_first_not_of(" \t\r", pos_), body_.size());
+    if (pos_ == body_.size() || body_[pos_] == '\n') return;
+    const size_t end = std::min(body_.find_first_of(" \t\r\n", pos_), body_.size());
+    fail_file(name_, fmt::format("vertex {}: its line holds more values than the vertex has "
+                                 "properties (from {})",
+                                 vertex, quote_token(body_.substr(pos_, end - pos_))));
+  }
+
  private:
+  [[noreturn]] void fail_truncated(size_t vertex) const {
+    fail_file(name_, fmt::format("truncated: the data ends at vertex {}", vertex));
+  }
+
   std::string_view body_;
   const fs::path& name_;
   size_t pos_ = 0;
@@ -419,6 +440,9 @@ class AsciiValues {
 class BinaryValues {
  public:
   explicit BinaryValues(std::string_view body) : next_(body.data()) {}
+
+  void begin_vertex(size_t) {}
+  void end_vertex(size_t) {}
 
   double next(size_t, const Property& property) {
     const double value = load_scalar(next_, property.type);
@@ -433,7 +457,8 @@ class BinaryValues {
 template <typename Values>
 void read_body(Values values, const Header& header, const std::vector<const Slot*>& targets,
                SplatCloud& cloud, const fs::path& name) {
-  for (size_t i = 0; i < header.vertex_count; ++i)
+  for (size_t i = 0; i < header.vertex_count; ++i) {
+    values.begin_vertex(i);
     for (size_t p = 0; p < header.properties.size(); ++p) {
       const double value = values.next(i, header.properties[p]);
       const Slot* slot = targets[p];
@@ -443,6 +468,8 @@ void read_body(Values values, const Header& header, const std::vector<const Slot
                                     slot->name, value));
       (cloud.*slot->field)[i * slot->width + slot->offset] = float(value);
     }
+    values.end_vertex(i);
+  }
 }
 
 // ---- point clouds ----
@@ -480,7 +507,9 @@ PointCloud read_points(Values values, const Header& header, const std::array<siz
   points.colors.resize(header.vertex_count);
   std::vector<double> row(header.properties.size());
   for (size_t i = 0; i < header.vertex_count; ++i) {
+    values.begin_vertex(i);
     for (size_t p = 0; p < row.size(); ++p) row[p] = values.next(i, header.properties[p]);
+    values.end_vertex(i);
     for (size_t k = 0; k < 3; ++k)
       if (!(std::fabs(row[index[k]]) <= FLT_MAX))
         fail_file(name, fmt::format("vertex {}: property '{}' is not a finite float ({})", i,

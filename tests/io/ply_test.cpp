@@ -333,7 +333,11 @@ TEST(Ply, RejectsBadInputNamingFileAndProblem) {
        "vertex 0: property 'z' is not a finite float"},
       {"word.ply", ascii_ply("1", "0 zero 0 0 0 0 0 0 0 0 1 0 0 0\n"),
        "vertex 0: property 'y' has a bad number 'zero'"},
-      {"short.ply", ascii_ply("2", row + "1 2 3\n"), "truncated: the data ends at vertex 1"},
+      {"short.ply", ascii_ply("2", row), "truncated: the data ends at vertex 1"},
+      {"shortline.ply", ascii_ply("2", "1 2 3\n" + row),
+       "vertex 0: its line ends before property 'f_dc_0'"},
+      {"longline.ply", ascii_ply("2", "0 0 0 0 0 0 0 0 0 0 1 0 0 0 9\n" + row),
+       "vertex 0: its line holds more values than the vertex has properties (from '9')"},
       {"face.ply",
        "ply\nformat ascii 1.0\nelement face 0\nproperty list uchar int vertex_indices\n"
        "end_header\n",
