@@ -34,7 +34,10 @@ std::string printable(std::string_view field) {
 // Walks a text file line by line and each line field by field; errors name the line.
 class TextReader {
  public:
-  TextReader(std::string_view text, const fs::path& source) : source_(source), rest_(text) {}
+  TextReader(std::string_view text, const fs::path& source) : source_(source), rest_(text) {
+    // Editors on Windows start UTF-8 files with a byte-order mark, invisible in any message.
+    if (rest_.substr(0, 3) == "\xEF\xBB\xBF") rest_.remove_prefix(3);
+  }
 
   // Moves to the next line holding data (not blank, not a comment); false at the end.
   bool next_data_line() {

@@ -203,10 +203,10 @@ TEST(Colmap, BinaryLayoutIsColmaps) {
 }
 
 TEST(Colmap, ReadsTextAsColmapWritesIt) {
-  // CRLF line endings, blank lines, an image whose observation line is empty and one whose
-  // observation line is missing at the end of the file.
+  // A byte-order mark, CRLF line endings, blank lines, an image whose observation line is empty
+  // and one whose observation line is missing at the end of the file.
   const std::string cameras =
-      "# Camera list with one line of data per camera:\r\n"
+      "\xEF\xBB\xBF# Camera list with one line of data per camera:\r\n"
       "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\r\n"
       "# Number of cameras: 1\r\n"
       "\r\n"
