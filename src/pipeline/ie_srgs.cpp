@@ -180,6 +180,11 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
   }
   lr_scene_ = load_scene(o_.scene, lr_options);
   refuse_output_in_scene_folder(o_.output, lr_scene_);
+  if (lr_scene_.split(Split::Test).empty())
+    fmt::print(
+        "note: {} has no test views: the rows are trained, but none is rendered or "
+        "scored\n",
+        lr_scene_.root.string());
   if (hr_scene_ && any_row([](const RowSpec& row) { return row.oracle_mask; }))
     require_scale_divides(*hr_scene_, lr_scene_, o_.scale);
   require_trainable_views(lr_scene_);
@@ -600,7 +605,13 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
   if (internal_) internal_current = true;
   for (const std::string& id : expand_rows({"all"})) {
     if (std::find(rows_.begin(), rows_.end(), id) != rows_.end()) continue;
-    const nlohmann::json earlier = read_stage_record(row_dir(id) / kRowResultFile);
+    const fs::path file = row_dir(id) / kRowResultFile;
+    const nlohmann::json earlier = read_stage_record(file);
+    // A row scored here whose record was damaged since: a silent gap in the table would read as a
+    // row never run.
+    if (fs::exists(file) && !earlier.contains("row"))
+      spdlog::warn("{}: damaged, so the table leaves the {} row out; --rows {} scores it again",
+                   file.string(), id, id);
     const nlohmann::json scored = earlier.value("evaluation", nlohmann::json());
     const auto same = [&](const char* key) {
       return scored.is_object() && scored.value(key, nlohmann::json()) == result.evaluation[key];

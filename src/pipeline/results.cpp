@@ -106,11 +106,12 @@ std::string results_markdown(const RunResult& result) {
   bool earlier = false;
   for (const RowResult& row : result.rows) {
     earlier = earlier || row.from_earlier_run;
-    md += fmt::format("| {}{} | {} | {} | {} | {} | {:.1f} |\n", row.label,
+    md += fmt::format("| {}{} | {} | {} | {} | {} | {} |\n", row.label,
                       row.from_earlier_run ? " *" : "", format_metric(row, row.mean.psnr, 2),
                       format_metric(row, row.mean.ssim, 4),
                       row.mean.lpips ? fmt::format("{:.4f}", *row.mean.lpips) : "-",
-                      format_duration(row.train_seconds), row.fps);
+                      format_duration(row.train_seconds),
+                      row.fps > 0 ? fmt::format("{:.1f}", row.fps) : "-");  // none rendered
   }
   if (earlier) md += "\n\\* from an earlier run in this folder with the same settings\n";
   return md + "\n" + stages_markdown(result);

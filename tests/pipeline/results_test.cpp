@@ -61,6 +61,8 @@ TEST(Results, MarkdownMarksEarlierRowsShowsDashesWithoutTruthAndTimesTheStages) 
   EXPECT_TRUE(contains(md, "| HR training, ie-srgs | 12s |\n")) << md;
   EXPECT_FALSE(contains(md, "HR training, internal")) << md;  // no time recorded for it
   EXPECT_TRUE(contains(md, "| this run in all | 2m10s |\n")) << md;
+  result.rows[0].fps = 0;  // a scene without test views renders none
+  EXPECT_TRUE(contains(results_markdown(result), "| internal only | - | - | - | 1m43s | - |\n"));
 }
 
 }  // namespace
