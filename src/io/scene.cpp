@@ -113,11 +113,16 @@ void require_pinhole_view(const Camera& camera) {
   const double widest = kWidestFieldOfView * kPi / 180;
   const bool finite =
       std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) && std::isfinite(k.cy);
-  if (finite && k.fov_x() < widest && k.fov_y() < widest) return;
+  // An optical axis more than the image's own size away from it is a unit or key mix-up, not a
+  // lens: such a view shows the model nowhere, and training on it "succeeds" on a blank render.
+  const bool centred =
+      k.cx >= -k.width && k.cx <= 2.0 * k.width && k.cy >= -k.height && k.cy <= 2.0 * k.height;
+  if (finite && centred && k.fov_x() < widest && k.fov_y() < widest) return;
   fail_file(camera.image_path,
             fmt::format("focal lengths {:.6g}, {:.6g} px and principal point {:.6g}, {:.6g} for "
-                        "a {}x{} image: a pinhole camera needs finite values and a field of view "
-                        "under {} degrees",
+                        "a {}x{} image: a pinhole camera needs finite values, a field of view "
+                        "under {} degrees and its principal point within an image's size of the "
+                        "image",
                         k.fx, k.fy, k.cx, k.cy, k.width, k.height, kWidestFieldOfView));
 }
 

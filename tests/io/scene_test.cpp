@@ -172,6 +172,27 @@ TEST(Scene, AFieldOfViewOf180DegreesIsRefused) {
   EXPECT_TRUE(contains(message, "r_0.png")) << message;
 }
 
+// cx of a million pixels for an 8-pixel image: a view that shows the model nowhere.
+TEST(Scene, APrincipalPointFarOutsideTheImageIsRefused) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 1});
+  const nlohmann::json blender =
+      nlohmann::json::parse(read_file(dir / "scene" / "transforms_train.json"));
+  nlohmann::json capture = {{"fl_x", 8}, {"fl_y", 8}, {"cx", 1e6}, {"cy", 4}, {"w", 8}, {"h", 8}};
+  for (nlohmann::json frame : blender["frames"]) {
+    frame["file_path"] = "scene/" + frame["file_path"].get<std::string>();
+    capture["frames"].push_back(frame);
+  }
+  write_file_atomically(dir / "transforms.json", capture.dump());
+  const std::string message = error_message([&] { load_scene(dir / "transforms.json"); });
+  EXPECT_TRUE(contains(message, "principal point 1e+06, 4 for a 8x8 image")) << message;
+  EXPECT_TRUE(contains(message, "its principal point within an image's size of the image"))
+      << message;
+  capture["cx"] = -7.5;  // off-centre, but a lens could be so
+  write_file_atomically(dir / "transforms.json", capture.dump());
+  EXPECT_EQ(load_scene(dir / "transforms.json").cameras.size(), 2u);
+}
+
 TEST(Scene, ADownscaleThatLeavesNoPixelIsRefused) {
   TempDir dir;
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 1});
