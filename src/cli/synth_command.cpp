@@ -37,7 +37,8 @@ void add_synth_command(CLI::App& app) {
   command->add_option("--test-views", options->test_views, "Test views (a spiral between them)")
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Picks layout, colours and patterns")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kNonNegative);  // -1 would wrap around to 2^64 - 1
   command->add_option("--samples", options->samples,
                       "Antialiasing samples per pixel, a square number (default: 16 up to 256 "
                       "px, 9 up to 512 px, 4 above)");
