@@ -257,7 +257,7 @@ void Trainer::require_same_cameras() const {
   if (stored != cameras_json(train_cameras_))
     fail_file(saved,
               "the run trained on other cameras than the scene given now: resume with the same "
-              "scene and --downscale");
+              "scene, --downscale and --test-every");
 }
 
 // K distinct views drawn afresh each step: multi-view regulation. The code of 3DGS and MVGS pops
