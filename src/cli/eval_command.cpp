@@ -166,9 +166,9 @@ std::filesystem::path report_base(const EvalArgs& args) {
   if (resolved_path(fs::path(base).concat(".json")) ==
       resolved_path(fs::path(args.renders) / "render.json"))
     fail_file(base, "would replace the renders' render.json; name the report otherwise");
-  const fs::path truth = args.ground_truth;
-  if (is_scene(truth) && resolved_path(base.parent_path()) ==
-                             resolved_path(fs::is_directory(truth) ? truth : truth.parent_path()))
+  // Resolved before taking the parent: a bare name's parent is "", which names no folder.
+  const fs::path truth = resolved_path(args.ground_truth);
+  if (is_scene(truth) && resolved_path(base).parent_path() == scene_folder(truth))
     fail_file(base,
               "is in the scene's own folder, whose files the report could replace; write "
               "it elsewhere (a folder inside it will do)");

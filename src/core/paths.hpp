@@ -11,12 +11,15 @@
 
 namespace iesrgs {
 
-// The path as the file system resolves it (links, "..", one folder named two ways), for telling
-// whether two paths name one file; as given, made absolute, when it cannot be resolved.
+// The absolute path as the file system resolves it (links, "..", one folder named two ways), for
+// telling whether two paths name one file; absolute but unresolved when it cannot be resolved.
+// Made absolute first: weakly_canonical leaves a relative path whose first part does not exist
+// relative.
 inline std::filesystem::path resolved_path(const std::filesystem::path& path) {
   std::error_code ec;
-  const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
-  return ec ? std::filesystem::absolute(path) : canonical;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
+  return ec ? absolute : canonical;
 }
 
 // The path an environment variable holds; none when it is unset or empty.

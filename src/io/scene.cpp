@@ -183,12 +183,12 @@ std::optional<std::string> camera_spread_warning(const Scene& scene) {
       cameras.size(), spread, 100 * spread / depth, depth);
 }
 
-fs::path scene_folder(const Scene& scene) {
-  return fs::is_directory(scene.root) ? scene.root : scene.root.parent_path();
+fs::path scene_folder(const fs::path& root) {
+  return fs::is_directory(root) ? root : root.parent_path();
 }
 
 void refuse_output_in_scene_folder(const fs::path& output, const Scene& scene) {
-  if (resolved_path(output) != resolved_path(scene_folder(scene))) return;
+  if (resolved_path(output) != resolved_path(scene_folder(scene.root))) return;
   fail_file(output,
             "is the scene's own folder, whose files the outputs could replace; write them "
             "elsewhere (a folder inside it will do)");

@@ -45,8 +45,9 @@ struct SceneOptions {
 // when two cameras of a split share a name, since their outputs would overwrite each other.
 Scene load_scene(const std::filesystem::path& root, const SceneOptions& options = {});
 
-// The folder holding the scene: its root, or the folder of the transforms.json given as the scene.
-std::filesystem::path scene_folder(const Scene& scene);
+// The folder holding the scene at `root` (a scene's own root, say): the folder itself, or that of
+// a transforms.json given as the scene.
+std::filesystem::path scene_folder(const std::filesystem::path& root);
 
 // Throws Error naming `output` when it is the scene's own folder, where outputs (rgb/, render.json,
 // point_cloud.ply, ...) could replace the scene's own files and a later command would remove them

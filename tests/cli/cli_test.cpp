@@ -343,6 +343,33 @@ TEST(Cli, EvalCompositesRgbaRendersOverTheBackground) {
   EXPECT_TRUE(contains(on_capture.output, "1 views: PSNR inf dB")) << on_capture.output;
 }
 
+// The report never replaces what eval reads: the scene's split file, the renders' record.
+TEST(Cli, EvalWritesNoReportOverItsInputs) {
+  TempDir dir;
+  const std::string scene = (dir / "scene").string(), renders = (dir / "renders").string();
+  ASSERT_EQ(iesrgs("synth -o " + scene + " --size 16 --views 2 --test-views 1").status, 0);
+  write_png(dir / "renders" / "r_0.png", Image8(16, 16, 3));
+  write_text(dir / "renders" / "render.json", R"({"finished": true, "split": "test"})");
+  const std::string split_file = read_file(dir / "scene" / "transforms_test.json");
+  // A bare name, from inside the scene: its parent is the working folder.
+  const std::filesystem::path working = std::filesystem::current_path();
+  std::filesystem::current_path(dir / "scene");
+  const CliRun into_scene = iesrgs("eval --lpips none ../renders . -o transforms_test");
+  std::filesystem::current_path(working);
+  EXPECT_EQ(into_scene.status, 1) << into_scene.output;
+  EXPECT_TRUE(contains(last_line(into_scene.output),
+                       "transforms_test: is in the scene's own folder, whose files the report "
+                       "could replace"))
+      << into_scene.output;
+  EXPECT_EQ(read_file(dir / "scene" / "transforms_test.json"), split_file);
+  const CliRun over_record =
+      iesrgs("eval --lpips none " + renders + " " + scene + " -o " + renders + "/render.csv");
+  EXPECT_EQ(over_record.status, 1) << over_record.output;
+  EXPECT_TRUE(contains(last_line(over_record.output), "would replace the renders' render.json"))
+      << over_record.output;
+  EXPECT_EQ(iesrgs("eval --lpips none " + renders + " " + scene).status, 0);  // metrics.json
+}
+
 TEST(Cli, EvalOfPartOfASplitNamesTheViewsLeftOut) {
   TempDir dir;
   const std::string scene = (dir / "scene").string();
