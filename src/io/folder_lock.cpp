@@ -98,16 +98,19 @@ void FolderLock::take(const fs::path& folder) {
   fd_ = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0)
     fail_file(folder, std::string("cannot open the output folder (") + std::strerror(errno) + ")");
-  if (!lock_exclusively(fd_))
+  if (!lock_exclusively(fd_)) {
+    created_.clear();  // another process holds them now, and may be about to write there
     fail_file(folder,
               "in use by another process (an iesrgs command, say); wait for it to end (or "
               "stop it) before writing to this folder again");
+  }
   refuse_around_held_folder(folder);
   remove_stale_temporaries(folder);
 }
 
 void FolderLock::release() {
-  // Still holding the lock, so that no other process starts writing in between.
+  // Still holding the lock (or never having got it, when created_ is empty), so that no other
+  // process starts writing in between.
   std::error_code ec;
   for (const fs::path& folder : created_)
     if (!fs::remove(folder, ec)) break;  // not empty: this and every parent stay
