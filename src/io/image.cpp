@@ -44,8 +44,10 @@ uint32_t big_endian32(std::string_view bytes, size_t at) {
 }
 
 // stb decodes a PNG without checking its chunks' CRCs, so a flipped byte of the pixel data would
-// decode into other pixels without a word; libpng and PIL refuse such a file, and so does this.
-// Chunks cut off by the end of the file are left to the decoder, which names the truncation.
+// decode into other pixels without a word. As libpng does, a chunk the image needs (a critical
+// one: its type starts upper-case; and tRNS, which stb reads) is refused when its CRC fails;
+// other ancillary chunks, which stb skips, are not checked. Chunks cut off by the end of the
+// file are left to the decoder, which names the truncation.
 void check_png_crcs(std::string_view bytes, const fs::path& path) {
   constexpr std::string_view kSignature = "\x89PNG\r\n\x1a\n";
   if (bytes.substr(0, kSignature.size()) != kSignature) return;
@@ -53,12 +55,12 @@ void check_png_crcs(std::string_view bytes, const fs::path& path) {
     const uint64_t length = big_endian32(bytes, at);
     if (at + 12 + length > bytes.size()) return;
     const std::string_view typed = bytes.substr(at + 4, 4 + length);  // the type and the data
-    const uint32_t crc =
-        uint32_t(crc32_z(0, reinterpret_cast<const Bytef*>(typed.data()), typed.size()));
-    if (crc != big_endian32(bytes, at + 8 + length))
-      fail_file(path, fmt::format("damaged: its PNG chunk {} at byte {} fails its CRC",
-                                  typed.substr(0, 4), at));
-    if (typed.substr(0, 4) == "IEND") return;
+    const std::string_view type = typed.substr(0, 4);
+    const bool needed = (type[0] & 0x20) == 0 || type == "tRNS";
+    if (needed && uint32_t(crc32_z(0, reinterpret_cast<const Bytef*>(typed.data()),
+                                   typed.size())) != big_endian32(bytes, at + 8 + length))
+      fail_file(path, fmt::format("damaged: its PNG chunk {} at byte {} fails its CRC", type, at));
+    if (type == "IEND") return;
     at += 12 + length;
   }
 }

@@ -129,6 +129,11 @@ TEST(Image, APngWhoseDataFailsItsCrcIsDamaged) {
   // stb wants the end chunk, and says nothing of why: the message does.
   EXPECT_EQ(error_message([&] { read_image8(dir / "no_end.png"); }),
             (dir / "no_end.png").string() + ": not a readable PNG/JPEG (damaged or truncated)");
+  // A text chunk, which stb skips, with a wrong CRC: libpng warns and reads the image, as here.
+  std::string text = read_file(dir / "ok.png");
+  text.insert(33, std::string("\0\0\0\5tEXta\0bcd\0\0\0\0", 17));  // after IHDR
+  write_text(dir / "text.png", text);
+  EXPECT_EQ(read_image8(dir / "text.png").data, gradient(64, 64, 3).data);
 }
 
 }  // namespace
