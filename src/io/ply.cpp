@@ -205,6 +205,7 @@ struct Header {
   std::optional<std::array<float, 3>> background;
   uint64_t vertex_count = 0;
   std::vector<Property> properties;  // of the vertex element
+  bool vertex_last = true;           // no element follows the vertices
   size_t body_offset = 0;
 };
 
@@ -298,7 +299,10 @@ class HeaderParser {
   void parse_element(const std::vector<std::string_view>& words) {
     if (words.size() != 3) fail_line("expected 'element <name> <count>'");
     in_vertex_ = !vertex_seen_;
-    if (!in_vertex_) return;  // later elements follow the vertex data and are not read
+    if (!in_vertex_) {  // later elements follow the vertex data and are not read
+      header_.vertex_last = false;
+      return;
+    }
     if (words[1] == "chunk")
       fail_line(
           "a compressed PLY (element 'chunk', then packed vertices, as SuperSplat and "
@@ -426,6 +430,12 @@ class AsciiValues {
                                  vertex, quote_token(body_.substr(pos_, end - pos_))));
   }
 
+  // After the last vertex of a file whose header declares nothing after them.
+  void end_body(uint64_t count) const {
+    if (body_.find_first_not_of(" \t\r\n", pos_) != std::string_view::npos)
+      fail_file(name_, fmt::format("holds more vertex data than the header's count of {}", count));
+  }
+
  private:
   [[noreturn]] void fail_truncated(size_t vertex) const {
     fail_file(name_, fmt::format("truncated: the data ends at vertex {}", vertex));
@@ -443,6 +453,7 @@ class BinaryValues {
 
   void begin_vertex(size_t) {}
   void end_vertex(size_t) {}
+  void end_body(uint64_t) const {}
 
   double next(size_t, const Property& property) {
     const double value = load_scalar(next_, property.type);
@@ -470,6 +481,7 @@ void read_body(Values values, const Header& header, const std::vector<const Slot
     }
     values.end_vertex(i);
   }
+  if (header.vertex_last) values.end_body(header.vertex_count);
 }
 
 // ---- point clouds ----
@@ -521,6 +533,7 @@ PointCloud read_points(Values values, const Header& header, const std::array<siz
           p == kNoProperty ? kGrey : color_byte(row[p], header.properties[p].type);
     }
   }
+  if (header.vertex_last) values.end_body(header.vertex_count);
   return points;
 }
 

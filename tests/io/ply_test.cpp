@@ -336,6 +336,8 @@ TEST(Ply, RejectsBadInputNamingFileAndProblem) {
       {"short.ply", ascii_ply("2", row), "truncated: the data ends at vertex 1"},
       {"shortline.ply", ascii_ply("2", "1 2 3\n" + row),
        "vertex 0: its line ends before property 'f_dc_0'"},
+      {"extra.ply", ascii_ply("1", row + row),
+       "holds more vertex data than the header's count of 1"},
       {"longline.ply", ascii_ply("2", "0 0 0 0 0 0 0 0 0 0 1 0 0 0 9\n" + row),
        "vertex 0: its line holds more values than the vertex has properties (from '9')"},
       {"face.ply",
