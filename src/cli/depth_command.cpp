@@ -64,8 +64,7 @@ void add_depth_command(CLI::App& app) {
   command
       ->add_option("OUT", args->out,
                    "For an image: the .npy to write, or an existing folder to write it into; for a "
-                   "folder: the "
-                   "folder to write into")
+                   "folder: the folder to write into")
       ->required()
       ->check(kNonEmptyPath);
   add_device_option(*command, args->device);

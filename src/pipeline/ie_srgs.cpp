@@ -182,7 +182,7 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
   refuse_output_in_scene_folder(o_.output, lr_scene_);
   if (lr_scene_.split(Split::Test).empty())
     fmt::print(
-        "note: {} has no test views: the rows are trained, but none is rendered or "
+        "note: {} has no test views: the models are trained, but no test view is rendered or "
         "scored\n",
         lr_scene_.root.string());
   if (hr_scene_ && any_row([](const RowSpec& row) { return row.oracle_mask; }))
@@ -606,29 +606,34 @@ void Pipeline::keep_earlier_rows(RunResult& result) const {
   for (const std::string& id : expand_rows({"all"})) {
     if (std::find(rows_.begin(), rows_.end(), id) != rows_.end()) continue;
     const fs::path file = row_dir(id) / kRowResultFile;
-    const nlohmann::json earlier = read_stage_record(file);
-    // A row scored here whose record was damaged since: a silent gap in the table would read as a
-    // row never run.
-    if (fs::exists(file) && !earlier.contains("row"))
+    if (!fs::exists(file)) continue;
+    // A row scored here whose record was damaged since (or copied from another row's): a silent
+    // gap in the table would read as a row never run.
+    const auto warn_damaged = [&] {
       spdlog::warn("{}: damaged, so the table leaves the {} row out; --rows {} scores it again",
                    file.string(), id, id);
+    };
+    const nlohmann::json earlier = read_stage_record(file);
     const nlohmann::json scored = earlier.value("evaluation", nlohmann::json());
+    const nlohmann::json entry = earlier.value("row", nlohmann::json());
+    if (!scored.is_object() || !entry.is_object() || entry.value("row", nlohmann::json()) != id) {
+      warn_damaged();
+      continue;
+    }
     const auto same = [&](const char* key) {
-      return scored.is_object() && scored.value(key, nlohmann::json()) == result.evaluation[key];
+      return scored.value(key, nlohmann::json()) == result.evaluation[key];
     };
     if (!same("test_views")) continue;
     try {
-      const nlohmann::json& entry = earlier.at("row");
       const RowSpec& row = row_spec(id);
       if (!internal_current)
         internal_current = internal_stage_current(lr_scene_, train_digest_, o_.internal_config,
                                                   o_.scale, o_.output / "internal");
-      const bool recorded_here = entry.at("row") == id;  // not a copy of another row's file
-      if (!recorded_here || !row_current(row, entry, *internal_current)) continue;
+      if (!row_current(row, entry, *internal_current)) continue;
       result.rows.push_back(earlier_row(row, row_label(row), entry));
       if (!same("lpips")) result.rows.back().mean.lpips.reset();
     } catch (const nlohmann::json::exception&) {
-      continue;
+      warn_damaged();  // a field of another type than the run writes
     }
   }
   std::stable_sort(result.rows.begin(), result.rows.end(), [](const auto& a, const auto& b) {

@@ -127,7 +127,7 @@ void write_results(const std::filesystem::path& dir, const RunResult& result) {
     csv += fmt::format("{},\"{}\",{},{},{},{},{}\n", row.id, row.label,
                        format_metric(row, row.mean.psnr, 4), format_metric(row, row.mean.ssim, 5),
                        row.mean.lpips ? fmt::format("{:.5f}", *row.mean.lpips) : "",
-                       row.train_seconds, row.fps);
+                       row.train_seconds, row.fps > 0 ? fmt::format("{}", row.fps) : "");
   }
   write_file_atomically(dir / "results.json", json.dump(2) + "\n");
   write_file_atomically(dir / "results.csv", csv);

@@ -36,8 +36,8 @@ std::vector<int64_t> spatial_size(const torch::Tensor& x, int64_t factor = 1) {
 }  // namespace
 
 ResidualConvUnitImpl::ResidualConvUnitImpl(int features)
-    : conv1_(register_module("conv1", same_conv(features, features, 3, true))),
-      conv2_(register_module("conv2", same_conv(features, features, 3, true))) {}
+    : conv1_(register_module("conv1", same_conv(features, features, 3, /*bias=*/true))),
+      conv2_(register_module("conv2", same_conv(features, features, 3, /*bias=*/true))) {}
 
 torch::Tensor ResidualConvUnitImpl::forward(const torch::Tensor& x) {
   return conv2_(torch::relu(conv1_(torch::relu(x)))) + x;
@@ -74,10 +74,10 @@ DptHeadImpl::DptHeadImpl(int in_channels, const DptConfig& config)
                                                    FeatureFusionBlock(config.features)));
   const int half = config.features / 2;
   output_conv1_ =
-      scratch->register_module("output_conv1", same_conv(config.features, half, 3, true));
+      scratch->register_module("output_conv1", same_conv(config.features, half, 3, /*bias=*/true));
   output_conv2_ = scratch->register_module(
       "output_conv2",
-      torch::nn::Sequential(same_conv(half, kHiddenChannels, 3, true), torch::nn::ReLU(),
+      torch::nn::Sequential(same_conv(half, kHiddenChannels, 3, /*bias=*/true), torch::nn::ReLU(),
                             Conv2d(Conv2dOptions(kHiddenChannels, 1, 1)), torch::nn::ReLU()));
 }
 
