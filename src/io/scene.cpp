@@ -66,7 +66,7 @@ void refuse_blender_split_file(const fs::path& file) {
   if (name != "transforms_train.json" && name != "transforms_test.json" &&
       name != "transforms_val.json")
     return;
-  const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  const fs::path folder = file.parent_path();  // load_scene made the path absolute
   if (detect_format(folder) == SceneFormat::Blender)
     fail_file(file, fmt::format("one split of a NeRF Synthetic scene: give the scene's folder, {}, "
                                 "which reads transforms_train.json and transforms_test.json",
