@@ -130,18 +130,24 @@ RenderedViewFiles rendered_view_files(const std::filesystem::path& dir, const st
 
 namespace {
 
-void write_rendered_view(const std::filesystem::path& dir, const std::string& name,
-                         const RenderedView& view) {
+// Returns how many pixels the 16-bit depth PNG clamps: the .npy beside it keeps their depth.
+size_t write_rendered_view(const std::filesystem::path& dir, const std::string& name,
+                           const RenderedView& view) {
   const RenderedViewFiles files = rendered_view_files(dir, name);
   const int height = int(view.depth.size(0)), width = int(view.depth.size(1));
   write_png(files.rgb, to_image8(view.image.unsqueeze(0)));
   const std::vector<float> depth = to_vector(view.depth);
   write_npy(files.depth_npy, depth, {size_t(height), size_t(width)});
   std::vector<uint16_t> depth16(depth.size());
-  for (size_t i = 0; i < depth.size(); ++i)
-    depth16[i] = uint16_t(std::clamp(std::lround(depth[i] * kDepthPngScale), 0L, 65535L));
+  size_t clamped = 0;
+  for (size_t i = 0; i < depth.size(); ++i) {
+    const long units = std::lround(depth[i] * kDepthPngScale);
+    clamped += units > 65535;
+    depth16[i] = uint16_t(std::clamp(units, 0L, 65535L));
+  }
   write_png16(files.depth_png, depth16, width, height);
   write_png(files.alpha, gray_image8(view.alpha));
+  return clamped;
 }
 
 }  // namespace
@@ -154,17 +160,23 @@ double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel
   // growing the allocator's pools, which would otherwise count against the rendering speed.
   if (!cameras.empty()) render_view(model, cameras.front().scaled(scale), background);
   double render_seconds = 0;
+  size_t clamped = 0;
   for (size_t i = 0; i < cameras.size(); ++i) {
     stop_if_interrupted("rendering");
     const Camera camera = cameras[i].scaled(scale);
     const Stopwatch watch;
     const RenderedView view = render_view(model, camera, background);
     render_seconds += watch.seconds();
-    write_rendered_view(dir, camera.name, view);
+    clamped += write_rendered_view(dir, camera.name, view);
     if ((i + 1) % 20 == 0 || i + 1 == cameras.size())
       fmt::print("rendered {}/{} views at {}x{}\n", i + 1, cameras.size(), camera.intrinsics.width,
                  camera.intrinsics.height);
   }
+  if (clamped)
+    fmt::print(
+        "note: {} pixels lie farther than {} scene units, the most a 16-bit depth PNG "
+        "holds at x{}; depth/*.npy keeps their depth\n",
+        clamped, 65535 / kDepthPngScale, kDepthPngScale);
   return cameras.empty() ? 0 : render_seconds / double(cameras.size());
 }
 
@@ -183,6 +195,7 @@ double render_views_recorded(const std::filesystem::path& dir, const gs::Gaussia
   record["gaussians"] = model.size();
   record["rasterize_mode"] = model.antialiased ? "antialiased" : "classic";
   record["background"] = background;
+  record["depth_png_scale"] = kDepthPngScale;
   record["names"] = names;
   record["finished"] = false;
   const std::filesystem::path path = dir / "render.json";

@@ -45,6 +45,26 @@ TEST(RenderViews, WritesEveryFileAtTheScaledSize) {
   EXPECT_EQ(depth.data[0], 0.0f);
 }
 
+// Depth beyond what 16 bits hold at the PNG's scale clamps there; the note says so, and the .npy
+// keeps the true depth.
+TEST(RenderViews, SaysWhenTheDepthPngClamps) {
+  testing::TempDir dir;
+  OneGaussian scene;
+  scene.camera = testing::camera_at({0, -70, 0}, {0, 0, 0});
+  scene.camera.name = "v";
+  scene.camera.intrinsics.fx = scene.camera.intrinsics.fy = 1000;  // a telephoto: still large
+  ::testing::internal::CaptureStdout();
+  render_views_to(dir.path(), scene.model, {scene.camera}, {1, 1, 1}, 1.0);
+  const std::string output = ::testing::internal::GetCapturedStdout();
+  EXPECT_NE(output.find("pixels lie farther than 65.535 scene units"), std::string::npos) << output;
+  const NpyArray depth = read_npy(rendered_view_files(dir.path(), "v").depth_npy);
+  EXPECT_NEAR(depth.data[24 * 64 + 32], 70.0f, 0.5f);
+
+  ::testing::internal::CaptureStdout();
+  render_views_to(dir.path(), OneGaussian().model, {OneGaussian().camera}, {1, 1, 1}, 1.0);
+  EXPECT_EQ(::testing::internal::GetCapturedStdout().find("note:"), std::string::npos);
+}
+
 // A recorded render into a folder replaces the earlier one's: its views this one does not make go
 // (a run's test views after another --test-every, say), and its scores with them.
 TEST(RenderViews, ARecordedRenderReplacesTheEarlierOne) {
@@ -66,6 +86,7 @@ TEST(RenderViews, ARecordedRenderReplacesTheEarlierOne) {
   const auto record = nlohmann::json::parse(read_file(dir / "render.json"));
   EXPECT_EQ(record["names"], nlohmann::json::array({"v"}));
   EXPECT_EQ(record["background"], nlohmann::json::array({0, 0, 0}));
+  EXPECT_EQ(record["depth_png_scale"], kDepthPngScale);
   EXPECT_EQ(record["split"], "test");
   EXPECT_EQ(record["finished"], true);
 }
