@@ -21,9 +21,10 @@ void add_device_option(CLI::App& command, std::string& device) {
 void add_lpips_option(CLI::App& command, std::string& backbone) {
   command
       .add_option("--lpips", backbone,
-                  "LPIPS backbone: alex, vgg or none (torchvision's checkpoint, looked up in "
+                  "LPIPS backbone: alex, vgg, vgg-3dgs (VGG given [0, 1] images, as 3DGS's and "
+                  "Mip-Splatting's metrics.py) or none (torchvision's checkpoint, looked up in "
                   "$IESRGS_WEIGHTS_DIR, else in torchvision's download cache)")
-      ->check(CLI::IsMember({"alex", "vgg", "none"}))
+      ->check(CLI::IsMember({"alex", "vgg", "vgg-3dgs", "none"}))
       ->capture_default_str();
 }
 

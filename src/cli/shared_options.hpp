@@ -13,7 +13,7 @@ namespace iesrgs::cli {
 // and the kernels of the commands that compute (train, render, the networks) run.
 void add_device_option(CLI::App& command, std::string& device);
 
-// Adds --lpips alex|vgg|none, the LPIPS backbone of the evaluations, stored in `backbone`.
+// Adds --lpips alex|vgg|vgg-3dgs|none, the LPIPS backbone of the evaluations, stored in `backbone`.
 void add_lpips_option(CLI::App& command, std::string& backbone);
 
 // Adds --background, the gray level in [0, 1] that the networks' commands composite transparent

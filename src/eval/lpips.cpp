@@ -55,19 +55,34 @@ constexpr std::array<size_t, 5> kAlexTaps = {1, 4, 7, 9, 11};   // relu1 .. relu
 constexpr std::array<size_t, 5> kVggTaps = {3, 8, 15, 22, 29};  // relu1_2, 2_2, 3_3, 4_3, 5_3
 
 struct NetSpec {
-  const char* name;           // LPIPS's
+  const char* name;           // as --lpips takes it
+  const char* heads;          // LPIPS's name of the network, which names its heads' file
   const char* backbone;       // for messages
   const char* backbone_file;  // torchvision's
   nn::Sequential (*features)();
   std::array<size_t, 5> taps;
-  int min_size;  // smallest side that still leaves every pooling an input
+  int min_size;       // smallest side that still leaves every pooling an input
+  bool signed_input;  // images mapped from [0, 1] to [-1, 1] first, as the official metric
 };
 
-const NetSpec kAlex{"alex", "AlexNet", "alexnet-owt-7be5be79.pth", alexnet_features, kAlexTaps, 31};
-const NetSpec kVgg{"vgg", "VGG16", "vgg16-397923af.pth", vgg16_features, kVggTaps, 16};
+const NetSpec kAlex{"alex",           "alex",    "AlexNet", "alexnet-owt-7be5be79.pth",
+                    alexnet_features, kAlexTaps, 31,        true};
+const NetSpec kVgg{"vgg", "vgg", "VGG16", "vgg16-397923af.pth", vgg16_features, kVggTaps, 16, true};
+const NetSpec kVgg3dgs{"vgg-3dgs",     "vgg",    "VGG16", "vgg16-397923af.pth",
+                       vgg16_features, kVggTaps, 16,      false};
+
+constexpr std::array<LpipsNet, 3> kNets = {LpipsNet::Alex, LpipsNet::Vgg, LpipsNet::Vgg3dgs};
 
 const NetSpec& spec(LpipsNet net) {
-  return net == LpipsNet::Alex ? kAlex : kVgg;
+  switch (net) {
+    case LpipsNet::Alex:
+      return kAlex;
+    case LpipsNet::Vgg:
+      return kVgg;
+    case LpipsNet::Vgg3dgs:
+      return kVgg3dgs;
+  }
+  fail("unknown LPIPS network");
 }
 
 // torch.hub's cache root, where torchvision downloads its checkpoints.
@@ -94,14 +109,16 @@ torch::Tensor unit_channels(const torch::Tensor& features) {
   return features / (features.pow(2).sum(1, /*keepdim=*/true).sqrt() + 1e-10);
 }
 
-// (1, 3, H, W) float on `device`, mapped from [0, 1] to [-1, 1] and then through LPIPS's
-// scaling layer, which standardizes by ImageNet's statistics in that range.
-torch::Tensor backbone_input(const torch::Tensor& image, const torch::Device& device) {
+// (1, 3, H, W) float on `device`, mapped from [0, 1] to [-1, 1] when `signed_input`, and then
+// through LPIPS's scaling layer, which standardizes by ImageNet's statistics in that range.
+torch::Tensor backbone_input(const torch::Tensor& image, const torch::Device& device,
+                             bool signed_input) {
   torch::Tensor x = (image.dim() == 3 ? image.unsqueeze(0) : image).to(device, torch::kFloat);
+  if (signed_input) x = 2 * x - 1;
   const auto options = torch::TensorOptions().device(device);
   const torch::Tensor shift = torch::tensor({-.030f, -.088f, -.188f}, options).view({1, 3, 1, 1});
   const torch::Tensor scale = torch::tensor({.458f, .448f, .450f}, options).view({1, 3, 1, 1});
-  return (2 * x - 1 - shift) / scale;
+  return (x - shift) / scale;
 }
 
 void check_image_pair(const torch::Tensor& a, const torch::Tensor& b, int min_size) {
@@ -123,10 +140,10 @@ void check_image_pair(const torch::Tensor& a, const torch::Tensor& b, int min_si
 }  // namespace
 
 LpipsNet parse_lpips_net(const std::string& name) {
-  for (LpipsNet net : {LpipsNet::Alex, LpipsNet::Vgg}) {
+  for (LpipsNet net : kNets) {
     if (name == spec(net).name) return net;
   }
-  fail("unknown LPIPS network '{}' (expected alex or vgg)", name);
+  fail("unknown LPIPS network '{}' (expected alex, vgg or vgg-3dgs)", name);
 }
 
 const char* lpips_net_name(LpipsNet net) {
@@ -138,8 +155,8 @@ LpipsWeights default_lpips_weights(LpipsNet net) {
   fs::path backbone = torch_home() / "hub" / "checkpoints" / net_spec.backbone_file;
   if (auto dir = env_path("IESRGS_WEIGHTS_DIR"); dir && is_file(*dir / net_spec.backbone_file))
     backbone = *dir / net_spec.backbone_file;
-  return {backbone,
-          priors::default_weights_dir() / "lpips" / "v0.1" / (std::string(net_spec.name) + ".pth")};
+  return {backbone, priors::default_weights_dir() / "lpips" / "v0.1" /
+                        (std::string(net_spec.heads) + ".pth")};
 }
 
 std::optional<std::string> lpips_unavailable_reason(LpipsNet net, const LpipsWeights& weights) {
@@ -149,7 +166,7 @@ std::optional<std::string> lpips_unavailable_reason(LpipsNet net, const LpipsWei
   }
   if (!is_file(weights.heads)) {
     return fmt::format("{}: no such file (LPIPS v0.1 {} linear heads)", weights.heads.string(),
-                       spec(net).name);
+                       spec(net).heads);
   }
   return std::nullopt;
 }
@@ -159,7 +176,8 @@ struct Lpips::Networks {
   explicit Networks(LpipsNet net)
       : features(backbone->register_module("features", spec(net).features())),
         taps(spec(net).taps),
-        min_size(spec(net).min_size) {
+        min_size(spec(net).min_size),
+        signed_input(spec(net).signed_input) {
     for (size_t k = 0; k < taps.size(); ++k) {
       // Official layout lin<k>.model = (dropout, 1x1 convolution without bias); dropout is the
       // identity outside training.
@@ -195,6 +213,7 @@ struct Lpips::Networks {
   std::vector<nn::Sequential> lin_models;
   std::array<size_t, 5> taps;
   int min_size;
+  bool signed_input;
   torch::Device device = torch::kCPU;
 };
 
@@ -226,8 +245,11 @@ void Lpips::to(const torch::Device& device) {
 float Lpips::distance(const torch::Tensor& a, const torch::Tensor& b) const {
   check_image_pair(a, b, networks_->min_size);
   torch::NoGradGuard no_grad;
-  const auto features_a = networks_->tapped_features(backbone_input(a, networks_->device));
-  const auto features_b = networks_->tapped_features(backbone_input(b, networks_->device));
+  const auto input = [&](const torch::Tensor& image) {
+    return backbone_input(image, networks_->device, networks_->signed_input);
+  };
+  const auto features_a = networks_->tapped_features(input(a));
+  const auto features_b = networks_->tapped_features(input(b));
   torch::Tensor total = torch::zeros({}, torch::TensorOptions().device(networks_->device));
   for (size_t k = 0; k < features_a.size(); ++k) {
     const torch::Tensor difference =

@@ -1,7 +1,9 @@
 #pragma once
 // LPIPS v0.1 (Zhang et al. 2018), the learned perceptual distance reported beside PSNR and SSIM:
 // an ImageNet AlexNet or VGG16 backbone with the authors' linear heads, both read from the
-// official checkpoints by their own parameter names.
+// official checkpoints by their own parameter names. "vgg-3dgs" is VGG16 scored as 3DGS's and
+// Mip-Splatting's metrics scripts score it, which is how the papers built on them report LPIPS:
+// with images given in [0, 1] where the official metric expects [-1, 1].
 #include <torch/torch.h>
 
 #include <filesystem>
@@ -13,9 +15,9 @@
 
 namespace iesrgs::eval {
 
-enum class LpipsNet { Alex, Vgg };
+enum class LpipsNet { Alex, Vgg, Vgg3dgs };
 
-// The official names, "alex" and "vgg"; throws Error for anything else.
+// "alex" and "vgg" (the official names) and "vgg-3dgs"; throws Error for anything else.
 LpipsNet parse_lpips_net(const std::string& name);
 const char* lpips_net_name(LpipsNet net);
 
@@ -49,8 +51,9 @@ class Lpips {
   // Moves the networks; distance() then runs there.
   void to(const torch::Device& device);
 
-  // The official lpips(a, b, normalize=True): RGB images in [0, 1], (3, H, W) or (1, 3, H, W),
-  // both the same size. Throws Error for other shapes or images below min_size().
+  // The official lpips(a, b, normalize=True) (normalize=False for vgg-3dgs): RGB images in
+  // [0, 1], (3, H, W) or (1, 3, H, W), both the same size. Throws Error for other shapes or
+  // images below min_size().
   float distance(const torch::Tensor& a, const torch::Tensor& b) const;
 
  private:
@@ -68,7 +71,7 @@ struct LoadedLpips {
   const Lpips* get() const { return metric ? &*metric : nullptr; }
 };
 
-// The metric from its default weights when "alex" or "vgg" names it and both files exist;
+// The metric from its default weights when a net's name names it and both files exist;
 // otherwise no metric, its status saying why ("not computed" for "none", or the missing file).
 LoadedLpips load_default_lpips(const std::string& name);
 

@@ -30,7 +30,7 @@ ViewMetrics measure_view(const std::string& name, const Image& render, const Ima
 
 struct MetricsReport {
   std::vector<ViewMetrics> views;
-  std::string lpips_status;           // "alex", "vgg", or why LPIPS is unavailable
+  std::string lpips_status;           // the net's name, or why LPIPS is unavailable
   std::vector<std::string> unscored;  // views of the split with no render: not in the mean
 
   ViewMetrics mean() const;  // name "mean"; lpips only when every view has it

@@ -80,7 +80,7 @@ const priors::StateDict& stand_in_backbone(LpipsNet net) {
 }
 
 fs::path heads_file(LpipsNet net) {
-  return kHeads / (std::string(lpips_net_name(net)) + ".pth");
+  return kHeads / (net == LpipsNet::Alex ? "alex.pth" : "vgg.pth");
 }
 
 Lpips stand_in_lpips(LpipsNet net) {
@@ -155,6 +155,21 @@ TEST_P(LpipsFixture, RejectsMismatchedOrTooSmallImages) {
 INSTANTIATE_TEST_SUITE_P(Backbones, LpipsFixture, ::testing::Values(LpipsNet::Alex, LpipsNet::Vgg),
                          [](const auto& info) { return std::string(lpips_net_name(info.param)); });
 
+// 3DGS's and Mip-Splatting's metrics give the official VGG metric [0, 1] images where it expects
+// [-1, 1]: the official distance of the images (x + 1) / 2, which map back to x.
+TEST(Lpips, Vgg3dgsIsTheOfficialVggOfImagesTakenInMinusOneToOne) {
+  if (!fs::exists(kHeads)) GTEST_SKIP() << "LPIPS heads not found: " << kHeads;
+  const Lpips official = stand_in_lpips(LpipsNet::Vgg);
+  const Lpips as_3dgs = stand_in_lpips(LpipsNet::Vgg3dgs);
+  for (const auto& [a, b] : fixture_pairs()) {
+    const float distance = as_3dgs.distance(a, b);
+    EXPECT_NEAR(distance, official.distance((a + 1) / 2, (b + 1) / 2), 1e-5);
+    EXPECT_GT(std::abs(distance - official.distance(a, b)), 1e-3);  // a different number
+  }
+  EXPECT_EQ(default_lpips_weights(LpipsNet::Vgg3dgs).heads,
+            default_lpips_weights(LpipsNet::Vgg).heads);
+}
+
 TEST(Lpips, RunsAtItsMinimumSize) {
   if (!fs::exists(kHeads)) GTEST_SKIP() << "LPIPS heads not found: " << kHeads;
   for (LpipsNet net : {LpipsNet::Alex, LpipsNet::Vgg}) {
@@ -192,6 +207,8 @@ TEST(Lpips, ErrorsNameTheCheckpointAndTheEntry) {
 TEST(Lpips, ParsesTheOfficialNetworkNames) {
   EXPECT_EQ(parse_lpips_net("alex"), LpipsNet::Alex);
   EXPECT_EQ(parse_lpips_net("vgg"), LpipsNet::Vgg);
+  EXPECT_EQ(parse_lpips_net("vgg-3dgs"), LpipsNet::Vgg3dgs);
+  EXPECT_EQ(lpips_net_name(LpipsNet::Vgg3dgs), std::string("vgg-3dgs"));
   EXPECT_NE(error_message([] { parse_lpips_net("squeeze"); }).find("'squeeze'"), std::string::npos);
 }
 
