@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <cmath>
 #include <functional>
 
 #include "raster/cpu/kernels.hpp"
@@ -85,13 +86,16 @@ void check_every_group(const Camera& cam, Scene<double> s, unsigned seed) {
   KernelRender<double> r = kernel_render(s, cam, kGradientBackground);
   const Gradients g = backward(s, r, loss);
   const auto evaluate = [&] { return loss(kernel_render(s, cam, kGradientBackground)); };
-  EXPECT_LT(group_error(s.means, g.means, evaluate), 1e-2) << "means";
-  EXPECT_LT(group_error(s.log_scales, g.log_scales, evaluate), 1e-2) << "log-scales";
-  EXPECT_LT(group_error(s.quats, g.quats, evaluate), 1e-2) << "quaternions";
-  EXPECT_LT(group_error(s.opacity_logits, g.logits, evaluate), 1e-2) << "opacity logits";
-  EXPECT_LT(group_error(s.sh_dc, g.sh_dc, evaluate), 1e-2) << "SH band 0";
+  // Double precision puts the true error near 1e-8; a dropped term of the chain is far above
+  // the bound even where it weighs little.
+  const double bound = 1e-5;
+  EXPECT_LT(group_error(s.means, g.means, evaluate), bound) << "means";
+  EXPECT_LT(group_error(s.log_scales, g.log_scales, evaluate), bound) << "log-scales";
+  EXPECT_LT(group_error(s.quats, g.quats, evaluate), bound) << "quaternions";
+  EXPECT_LT(group_error(s.opacity_logits, g.logits, evaluate), bound) << "opacity logits";
+  EXPECT_LT(group_error(s.sh_dc, g.sh_dc, evaluate), bound) << "SH band 0";
   if (s.sh_degree > 0) {  // degree 0 reads no higher band
-    EXPECT_LT(group_error(s.sh_rest, g.sh_rest, evaluate), 1e-2) << "SH bands 1-3";
+    EXPECT_LT(group_error(s.sh_rest, g.sh_rest, evaluate), bound) << "SH bands 1-3";
   }
 }
 
@@ -147,6 +151,15 @@ TEST(RasterBackward, MatchesFiniteDifferencesAtEveryShDegree) {
     const Scene<double> s = random_scene(cam, 8, degree, 20 + degree, false);
     check_every_group(cam, s, 40 + degree);
   }
+}
+
+// A 3D filter as wide as each Gaussian's first axis: the filter's opacity factor then weighs on
+// the scales' gradients as much as the footprint does.
+TEST(RasterBackward, WideThreeDFilterMatchesFiniteDifferences) {
+  const Camera cam = posed_test_camera(24, 20);
+  Scene<double> s = random_scene(cam, 10, 1, 37, false);
+  for (size_t i = 0; i < s.filter_std.size(); ++i) s.filter_std[i] = std::exp(s.log_scales[3 * i]);
+  check_every_group(cam, s, 38);
 }
 
 TEST(RasterBackward, ClassicDilationMatchesFiniteDifferences) {
