@@ -48,6 +48,19 @@ TEST(Filter3d, FrameMarginIsFifteenPercent) {
   EXPECT_NEAR(s[1], 11 * k, 1e-6);
 }
 
+TEST(Filter3d, VerticalMarginTakesFyAndTheHeight) {
+  Camera near = camera_at({0, 0, 0}, 100);
+  near.intrinsics.fy = 50;
+  const std::vector<Camera> cameras = {near, camera_at({0, 0, -10}, 100)};
+  // v = 50 y / 1 + 40 against the bound 1.15 x 80 = 92: y = 1.0 -> 90 (inside), y = 1.1 -> 95
+  // (outside, though inside the width's bound, 115). With fx for fy, y = 1.0 would land at 140.
+  const float means[] = {0.f, 1.0f, 1.f, 0.f, 1.1f, 1.f};
+  const std::vector<float> s = filter3d_std(means, 2, cameras);
+  const double k = std::sqrt(0.2) / 100;
+  EXPECT_NEAR(s[0], 1 * k, 1e-7);
+  EXPECT_NEAR(s[1], 11 * k, 1e-6);
+}
+
 TEST(Filter3d, NeedsCameras) {
   EXPECT_THROW(filter3d_std(nullptr, 0, {}), Error);
 }
