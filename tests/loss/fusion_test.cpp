@@ -38,9 +38,15 @@ FusionTargets external_targets(uint64_t seed) {
   return targets;
 }
 
+// Every test draws from one seed, so that what it draws does not depend on the tests before it.
+class FusionLoss : public ::testing::Test {
+ protected:
+  void SetUp() override { torch::manual_seed(11); }
+};
+
 const FusionWeights kDepthWeights{TextureGuidance::External, 0.2, 1e-3, 1e-4};
 
-TEST(FusionLoss, ExternalTextureIsThePhotometricLossAgainstE) {
+TEST_F(FusionLoss, ExternalTextureIsThePhotometricLossAgainstE) {
   raster::RenderOutput render;
   render.image = random_image(1).requires_grad_();
   FusionTargets targets;
@@ -60,7 +66,7 @@ TEST(FusionLoss, ExternalTextureIsThePhotometricLossAgainstE) {
   EXPECT_TRUE(torch::allclose(grad, render.image.grad(), 1e-5, 1e-7));
 }
 
-TEST(FusionLoss, MaskedShareIsTheDiscrepancyMaskAndOthersAreConstant) {
+TEST_F(FusionLoss, MaskedShareIsTheDiscrepancyMaskAndOthersAreConstant) {
   const torch::Tensor internal = random_image(3), external = random_image(4);
   const torch::Tensor d = discrepancy(internal, external);
   const torch::Tensor expected_d = ((internal - external).abs() / (internal + 1e-6)).mean(0);
@@ -75,7 +81,7 @@ TEST(FusionLoss, MaskedShareIsTheDiscrepancyMaskAndOthersAreConstant) {
                   .item<bool>());
 }
 
-TEST(FusionLoss, DepthTermsVanishForMatchingGeometryAndIgnoreUncoveredPixels) {
+TEST_F(FusionLoss, DepthTermsVanishForMatchingGeometryAndIgnoreUncoveredPixels) {
   const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
   raster::RenderOutput render = render_with_depth(depth, 3);
   FusionTargets targets = external_targets(5);
@@ -91,7 +97,7 @@ TEST(FusionLoss, DepthTermsVanishForMatchingGeometryAndIgnoreUncoveredPixels) {
 
 // The rendered depth is alpha-blended z: the disparity correlated is alpha / blended z, the
 // inverse of the expected depth, and pixels under alpha 0.5 are left out.
-TEST(FusionLoss, ExternalDepthTermCorrelatesTheInverseExpectedDepthOfCoveredPixels) {
+TEST_F(FusionLoss, ExternalDepthTermCorrelatesTheInverseExpectedDepthOfCoveredPixels) {
   torch::manual_seed(11);
   const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
   torch::Tensor alpha = 0.6 + 0.4 * torch::rand({kHeight, kWidth});
@@ -109,7 +115,7 @@ TEST(FusionLoss, ExternalDepthTermCorrelatesTheInverseExpectedDepthOfCoveredPixe
 }
 
 // The paper's weights: l = 0.2 in L_tex, li = 0.001 on L_gem^I, le = 0.0001 on L_gem^E.
-TEST(FusionLoss, DefaultWeightsAreThePapersAndWeighTheTerms) {
+TEST_F(FusionLoss, DefaultWeightsAreThePapersAndWeighTheTerms) {
   const FusionWeights defaults;
   EXPECT_EQ(defaults.texture, TextureGuidance::Masked);
   EXPECT_EQ(defaults.dssim_weight, 0.2);
@@ -136,7 +142,7 @@ TEST(FusionLoss, DefaultWeightsAreThePapersAndWeighTheTerms) {
               1e-7);  // float sums; swapping li and le would move it by about 4e-4
 }
 
-TEST(FusionLoss, DepthTermsPullTheRenderedDepthTowardsTheReferences) {
+TEST_F(FusionLoss, DepthTermsPullTheRenderedDepthTowardsTheReferences) {
   const torch::Tensor depth = 1 + torch::rand({kHeight, kWidth});
   raster::RenderOutput render = render_with_depth(depth, 0);
   FusionTargets targets = external_targets(6);
@@ -154,7 +160,7 @@ TEST(FusionLoss, DepthTermsPullTheRenderedDepthTowardsTheReferences) {
   EXPECT_TRUE(torch::all(render.depth.grad() < 0).item<bool>());
 }
 
-TEST(FusionLoss, InternalDepthTermIsZeroWhereNothingIsCovered) {
+TEST_F(FusionLoss, InternalDepthTermIsZeroWhereNothingIsCovered) {
   raster::RenderOutput render = render_with_depth(1 + torch::rand({kHeight, kWidth}), kWidth);
   FusionTargets targets = external_targets(8);
   targets.internal_depth = torch::full({kHeight, kWidth}, 2.0);
@@ -166,7 +172,7 @@ TEST(FusionLoss, InternalDepthTermIsZeroWhereNothingIsCovered) {
   EXPECT_EQ(render.depth.grad().abs().sum().item<double>(), 0);
 }
 
-TEST(FusionLoss, DiscrepancyRefusesImagesItCannotCompare) {
+TEST_F(FusionLoss, DiscrepancyRefusesImagesItCannotCompare) {
   const torch::Tensor internal = random_image(3);
   const std::string smaller = testing::error_message(
       [&] { discrepancy(internal, internal.narrow(2, 0, kWidth - 1).contiguous()); });
@@ -176,7 +182,7 @@ TEST(FusionLoss, DiscrepancyRefusesImagesItCannotCompare) {
   EXPECT_THROW(internal_share(TextureGuidance::Masked, internal, torch::Tensor(), 0.5), Error);
 }
 
-TEST(FusionLoss, MissingReferenceOrUnknownGuidanceIsAnError) {
+TEST_F(FusionLoss, MissingReferenceOrUnknownGuidanceIsAnError) {
   EXPECT_THROW(parse_texture_guidance("mixed"), Error);
   EXPECT_EQ(parse_texture_guidance("average"), TextureGuidance::Average);
   raster::RenderOutput render;
