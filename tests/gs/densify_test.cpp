@@ -30,9 +30,11 @@ GaussianModel tiny_model(const std::vector<float>& scales, const std::vector<flo
   return m;
 }
 
+// A view's statistics: screen-space gradients of norm grad_norms[i], and absolute ones (AbsGS's)
+// of twice that norm, so that which of the two is read shows.
 ViewStatistics view(const std::vector<float>& grad_norms, const std::vector<int>& radii) {
   const Tensor g = torch::tensor(grad_norms);
-  return {torch::stack({g * 0.6, g * 0.8}, 1), torch::stack({g, torch::zeros_like(g)}, 1),
+  return {torch::stack({g * 0.6, g * 0.8}, 1), torch::stack({g * 1.2, g * 1.6}, 1),
           torch::tensor(radii, torch::kInt32)};
 }
 
@@ -54,7 +56,7 @@ TEST(Densify, AccumulatesEveryViewWhereTheGaussianIsDrawn) {
   DensifyStats stats = DensifyStats::zeros(3);
   stats.accumulate({view({1, 2, 3}, {5, 0, 2}), view({10, 20, 30}, {0, 4, 7})});
   EXPECT_TRUE(torch::allclose(stats.grad_sum, torch::tensor({1.f, 20.f, 33.f})));
-  EXPECT_TRUE(torch::allclose(stats.abs_grad_sum, torch::tensor({1.f, 20.f, 33.f})));
+  EXPECT_TRUE(torch::allclose(stats.abs_grad_sum, torch::tensor({2.f, 40.f, 66.f})));
   EXPECT_TRUE(torch::equal(stats.count, torch::tensor({1.f, 1.f, 2.f})));
   EXPECT_TRUE(torch::equal(stats.max_radii, torch::tensor({5.f, 4.f, 7.f})));
   EXPECT_THROW(stats.accumulate({view({1, 2}, {1, 1})}), Error);
@@ -151,12 +153,12 @@ TEST(Densify, AbsoluteGradientsCanDriveDensification) {
   GaussianModel m = tiny_model({0.05f}, {0.5f});
   GaussianOptimizer opt(m, {}, kExtent);
   DensifyStats stats = DensifyStats::zeros(1);
-  // Norm of the plain gradient 1.5e-4, of the absolute one 1.5e-4 / 0.6 = 2.5e-4.
-  stats.accumulate({view({1.5e-4f / 0.6f}, {1})});
-  stats.grad_sum = torch::tensor({1.5e-4f});
+  // Norm of the plain gradient 1.5e-4, under the 2e-4 threshold; of the absolute one 3e-4, over.
+  stats.accumulate({view({1.5e-4f}, {1})});
   DensifyOptions options;
   EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).cloned, 0);
-  stats.accumulate({view({2.5e-4f}, {1})});
+  ASSERT_EQ(m.size(), 1);
+  stats.accumulate({view({1.5e-4f}, {1})});  // the same view again: densifying zeroed the sums
   options.source = GradientSource::Absolute;
   EXPECT_EQ(densify_and_prune(m, opt, stats, options, kExtent).cloned, 1);
 }
