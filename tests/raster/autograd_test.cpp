@@ -49,6 +49,7 @@ void expect_gradients_match_the_raw_backward(bool antialiased) {
 
   KernelRender<float> raw = kernel_render(s, cam, bg);
   EXPECT_EQ(values(out.image), raw.image);
+  EXPECT_EQ(values(out.alpha), raw.alpha);
   EXPECT_EQ(values(out.depth), raw.depth);
   std::vector<float> dmeans(3 * n), dscales(3 * n), dquats(4 * n), dlogits(n), dsh_dc(3 * n),
       dsh_rest(45 * n), dview(2 * n), dview_abs(2 * n);

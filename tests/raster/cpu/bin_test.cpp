@@ -56,6 +56,13 @@ void expect_binned_in_order(const BinCase& c) {
   bin_splats(c.splats.data(), c.rects.data(), int(c.rects.size()), c.width, c.height, bins);
   const auto expected = expected_tiles(c);
   ASSERT_EQ(size_t(bins.tile_count()), expected.size());
+  // The backward pass writes each entry's partial gradient to its slot: no two may share one.
+  std::vector<int> slot_uses(bins.entry_slot.size(), 0);
+  for (uint32_t slot : bins.entry_slot) {
+    ASSERT_LT(slot, slot_uses.size());
+    ++slot_uses[slot];
+  }
+  EXPECT_EQ(std::count(slot_uses.begin(), slot_uses.end(), 1), std::ptrdiff_t(slot_uses.size()));
   for (size_t t = 0; t < expected.size(); ++t) {
     const std::vector<uint32_t> got(bins.entry_gaussian.begin() + bins.tile_start[t],
                                     bins.entry_gaussian.begin() + bins.tile_start[t + 1]);
