@@ -157,6 +157,54 @@ TEST_F(TrainerTest, EachStepSumsTheLossesOfThreeDistinctViews) {
   EXPECT_EQ(summary.final_loss, double(views[last] + views[last + 1] + views[last + 2] + 3));
 }
 
+// The schedule as the loss sees it, iteration by iteration: the SH degree steps up every
+// sh_increase_every; the model changes size only after a densification step inside the window;
+// opacities drop to a tenth only after a reset inside it (over black: no reset at densify_from).
+TEST_F(TrainerTest, RefinesOnItsSchedule) {
+  TempDir out;
+  TrainerSetup s = setup(out.path());
+  s.background = {0, 0, 0};
+  TrainConfig c = config();
+  c.views_per_iteration = 1;
+  c.max_sh_degree = 2;
+  c.sh_increase_every = 10;
+  c.densify_from = 5;
+  c.densify_until = 25;
+  c.densify_every = 5;
+  c.opacity_reset_every = 15;
+  struct Seen {
+    int sh_degree;
+    int64_t size;
+    double mean_opacity;
+  };
+  std::vector<Seen> seen;  // seen[i - 1]: at iteration i, after refining at i - 1
+  const Trainer* trainer = nullptr;
+  const std::vector<TrainView> views = s.train_views;
+  s.loss = [&](int view, const raster::RenderOutput& render) {
+    const gs::GaussianModel& model = trainer->model();
+    seen.push_back({model.active_sh_degree, model.size(),
+                    torch::sigmoid(model.opacity_logits).mean().item<double>()});
+    return loss::photometric_autograd(render.image, views[size_t(view)].target, c.dssim_weight);
+  };
+  Trainer run(c, s, initial());
+  trainer = &run;
+  run.run();
+  ASSERT_EQ(seen.size(), 40u);
+  bool resized = false;
+  for (int i = 1; i <= 40; ++i) {
+    EXPECT_EQ(seen[i - 1].sh_degree, std::min(2, i / 10)) << "iteration " << i;
+    if (i == 40) break;
+    const Seen &now = seen[i - 1], &next = seen[i];
+    const bool densified = i == 10 || i == 15 || i == 20;
+    if (!densified) EXPECT_EQ(next.size, now.size) << "after iteration " << i;
+    resized |= next.size != now.size;
+    const bool reset = next.mean_opacity < 0.5 * now.mean_opacity;
+    EXPECT_EQ(reset, i == 15) << "after iteration " << i << ": " << now.mean_opacity << " -> "
+                              << next.mean_opacity;
+  }
+  EXPECT_TRUE(resized);
+}
+
 TEST_F(TrainerTest, MaxGaussiansCapsTheGrowth) {
   TempDir free_dir, capped_dir;
   Trainer free(config(), setup(free_dir.path()), initial());
