@@ -209,13 +209,15 @@ void run_eval(const EvalArgs& args) {
   eval::write_report(base, report);
   if (!unscored.empty())
     fmt::print(
-        "note: {} views of {} have no render and are not in the mean: {}{}\n", unscored.size(),
+        "note: {} of {} {} no render and {} not in the mean: {}{}\n",
+        unscored.size() == 1 ? "1 view" : fmt::format("{} views", unscored.size()),
         is_scene(args.ground_truth) ? "the " + args.split + " split" : args.ground_truth,
+        unscored.size() == 1 ? "has" : "have", unscored.size() == 1 ? "is" : "are",
         fmt::join(unscored.begin(), unscored.begin() + std::min<size_t>(5, unscored.size()), ", "),
         unscored.size() > 5 ? ", ..." : "");
   const eval::ViewMetrics mean = report.mean();
-  fmt::print("{} views: PSNR {:.3f} dB, SSIM {:.4f}, LPIPS {}\nwrote {}.json and .csv\n",
-             report.views.size(), mean.psnr, mean.ssim,
+  fmt::print("{} view{}: PSNR {:.3f} dB, SSIM {:.4f}, LPIPS {}\nwrote {}.json and .csv\n",
+             report.views.size(), report.views.size() == 1 ? "" : "s", mean.psnr, mean.ssim,
              mean.lpips ? fmt::format("{:.4f}", *mean.lpips) : report.lpips_status, base.string());
 }
 

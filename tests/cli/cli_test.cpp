@@ -308,15 +308,15 @@ TEST(Cli, EvalCompositesRgbaRendersOverTheBackground) {
   const std::string folders = (dir / "renders").string() + " " + (dir / "truth").string();
   const CliRun on_white = iesrgs("eval --lpips none " + folders);
   EXPECT_EQ(on_white.status, 0) << on_white.output;
-  EXPECT_TRUE(contains(on_white.output, "1 views: PSNR inf dB, SSIM 1.0000")) << on_white.output;
+  EXPECT_TRUE(contains(on_white.output, "1 view: PSNR inf dB, SSIM 1.0000")) << on_white.output;
   const CliRun on_black = iesrgs("eval --lpips none --background black " + folders);
   EXPECT_EQ(on_black.status, 0) << on_black.output;
-  EXPECT_TRUE(contains(on_black.output, "1 views: PSNR 0.000 dB")) << on_black.output;
+  EXPECT_TRUE(contains(on_black.output, "1 view: PSNR 0.000 dB")) << on_black.output;
   // By default, the background the renders were drawn over, as their render.json records it.
   write_text(dir / "renders" / "render.json", R"({"finished": true, "background": [0, 0, 0]})");
   const CliRun recorded = iesrgs("eval --lpips none " + folders);
   EXPECT_EQ(recorded.status, 0) << recorded.output;
-  EXPECT_TRUE(contains(recorded.output, "1 views: PSNR 0.000 dB")) << recorded.output;
+  EXPECT_TRUE(contains(recorded.output, "1 view: PSNR 0.000 dB")) << recorded.output;
   std::filesystem::remove(dir / "renders" / "render.json");
 
   // Against a capture, the scene's background (black): the held-out photo, with white
@@ -340,7 +340,7 @@ TEST(Cli, EvalCompositesRgbaRendersOverTheBackground) {
   const CliRun on_capture =
       iesrgs("eval --lpips none " + (dir / "capture_renders").string() + " " + capture);
   EXPECT_EQ(on_capture.status, 0) << on_capture.output;
-  EXPECT_TRUE(contains(on_capture.output, "1 views: PSNR inf dB")) << on_capture.output;
+  EXPECT_TRUE(contains(on_capture.output, "1 view: PSNR inf dB")) << on_capture.output;
 }
 
 // The report never replaces what eval reads: the scene's split file, the renders' record.
@@ -378,8 +378,8 @@ TEST(Cli, EvalOfPartOfASplitNamesTheViewsLeftOut) {
   const CliRun run = iesrgs("eval --lpips none " + (dir / "renders").string() + " " + scene);
   EXPECT_EQ(run.status, 0) << run.output;
   EXPECT_TRUE(contains(run.output,
-                       "1 views of the test split have no render and are not in the "
-                       "mean: r_1\n1 views: PSNR inf dB"))
+                       "1 view of the test split has no render and is not in the "
+                       "mean: r_1\n1 view: PSNR inf dB"))
       << run.output;
   const auto report = nlohmann::json::parse(read_file(dir / "renders" / "metrics.json"));
   EXPECT_EQ(report["unscored_views"], nlohmann::json::array({"r_1"}));
@@ -389,7 +389,7 @@ TEST(Cli, EvalOfPartOfASplitNamesTheViewsLeftOut) {
   const CliRun folder = iesrgs("eval --lpips none " + (dir / "renders").string() + " " + truth +
                                " -o " + (dir / "scores").string() + "/");
   EXPECT_EQ(folder.status, 0) << folder.output;
-  EXPECT_TRUE(contains(folder.output, "1 views of " + truth + " have no render")) << folder.output;
+  EXPECT_TRUE(contains(folder.output, "1 view of " + truth + " has no render")) << folder.output;
   EXPECT_EQ(nlohmann::json::parse(read_file(dir / "scores" / "metrics.json"))["unscored_views"],
             nlohmann::json::array({"r_1"}));
 
