@@ -34,6 +34,9 @@ std::string decode_problem() {
   const char* reason = stbi_failure_reason();
   if (reason && std::string_view(reason) == "can't fopen")
     return std::string("cannot be opened: ") + std::strerror(open_error);
+  if (reason && std::string_view(reason) == "too large")  // or damaged: a header's size is read
+    return "too large to decode: more than 16777216 pixels a side or 2 GiB of pixels, or its "
+           "header is damaged";
   return std::string("not a readable PNG/JPEG (") +
          (reason && *reason ? reason : "damaged or truncated") + ")";
 }

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 #include <stb/stb_image.h>
+#include <zlib.h>
 
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
@@ -129,6 +130,16 @@ TEST(Image, APngWhoseDataFailsItsCrcIsDamaged) {
   // stb wants the end chunk, and says nothing of why: the message does.
   EXPECT_EQ(error_message([&] { read_image8(dir / "no_end.png"); }),
             (dir / "no_end.png").string() + ": not a readable PNG/JPEG (damaged or truncated)");
+  // A header claiming 2^25 pixels a side (its CRC right): stb's bare "too large" is explained.
+  std::string huge = read_file(dir / "ok.png");
+  huge.replace(16, 4, std::string("\x02\0\0\0", 4));  // IHDR's width
+  const uLong crc = crc32(0, reinterpret_cast<const Bytef*>(huge.data() + 12), 17);
+  for (int k = 0; k < 4; ++k) huge[29 + k] = char(crc >> (24 - 8 * k));
+  write_text(dir / "huge.png", huge);
+  EXPECT_NE(error_message([&] {
+              read_image8(dir / "huge.png");
+            }).find("too large to decode: more than 16777216 pixels a side"),
+            std::string::npos);
   // A text chunk, which stb skips, with a wrong CRC: libpng warns and reads the image, as here.
   std::string text = read_file(dir / "ok.png");
   text.insert(33, std::string("\0\0\0\5tEXta\0bcd\0\0\0\0", 17));  // after IHDR
