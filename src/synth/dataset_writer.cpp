@@ -43,6 +43,12 @@ void check_options(const SynthOptions& options) {
     fail("synthetic scene: training views must be 1 to {}, got {}", kMaxViews, options.train_views);
   if (options.test_views < 0 || options.test_views > kMaxViews)
     fail("synthetic scene: test views must be 0 to {}, got {}", kMaxViews, options.test_views);
+  // The capture holds out every 8th image from its first: one image alone would all be test.
+  if (options.format == SynthFormat::Colmap && options.train_views + options.test_views < 2)
+    fail(
+        "synthetic scene: a COLMAP capture holds out its first image for test, so it needs at "
+        "least 2 views and test views together, got {}",
+        options.train_views + options.test_views);
 }
 
 struct SplitViews {

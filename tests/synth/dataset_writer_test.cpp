@@ -224,6 +224,13 @@ TEST(SynthDataset, RejectsBadOptions) {
   options.test_views = -1;
   EXPECT_NE(error_message([&] { write_synth_dataset(dir.path(), options); }).find("test views"),
             std::string::npos);
+  options = tiny();
+  options.format = SynthFormat::Colmap;
+  options.train_views = 1;
+  options.test_views = 0;
+  EXPECT_EQ(error_message([&] { write_synth_dataset(dir.path(), options); }),
+            "synthetic scene: a COLMAP capture holds out its first image for test, so it needs "
+            "at least 2 views and test views together, got 1");
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
