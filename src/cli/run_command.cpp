@@ -160,6 +160,16 @@ void add_pipeline_command(CLI::App& app, const std::string& name, const std::str
                           ->capture_default_str()
                           ->check(kNonNegative);
   add_device_option(*command, args->device);
+  // Not listed: train's flag, which users carry over, answered with what to do instead.
+  command
+      ->add_flag_callback("--resume",
+                          [name] {
+                            fail(
+                                "{} has no --resume: it resumes by itself; run the same command "
+                                "without it",
+                                name);
+                          })
+      ->group("");
   command->callback([args, only, seed] {
     for (TrainingArgs* training : {&args->internal, &args->fusion}) {
       training->options.seed = seed;

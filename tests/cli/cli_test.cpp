@@ -49,6 +49,22 @@ TEST(Cli, InternalHelpSetsTheOtherStagesOptionsApart) {
   EXPECT_EQ(iesrgs("run --help").output.find("Options of the other stages"), std::string::npos);
 }
 
+// train's --resume, carried over to the pipeline, says what to do, and creates nothing.
+TEST(Cli, PipelineCommandsAnswerResumeWithWhatToDo) {
+  TempDir dir;
+  for (const std::string command : {"run", "internal", "fuse"}) {
+    const CliRun run = iesrgs(command + " " + (dir / "scene").string() + " -o " +
+                              (dir / "out").string() + " --resume");
+    EXPECT_EQ(run.status, 1) << command;
+    EXPECT_EQ(last_line(run.output), "error: " + command +
+                                         " has no --resume: it resumes by itself; run the same "
+                                         "command without it")
+        << run.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  EXPECT_EQ(iesrgs("run --help").output.find("--resume"), std::string::npos);
+}
+
 TEST(Cli, VersionSaysWhichDeviceAutoTakes) {
   const CliRun run = iesrgs("--version");
   EXPECT_EQ(run.status, 0);
