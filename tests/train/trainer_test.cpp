@@ -196,7 +196,9 @@ TEST_F(TrainerTest, RefinesOnItsSchedule) {
     if (i == 40) break;
     const Seen &now = seen[i - 1], &next = seen[i];
     const bool densified = i == 10 || i == 15 || i == 20;
-    if (!densified) EXPECT_EQ(next.size, now.size) << "after iteration " << i;
+    if (!densified) {
+      EXPECT_EQ(next.size, now.size) << "after iteration " << i;
+    }
     resized |= next.size != now.size;
     const bool reset = next.mean_opacity < 0.5 * now.mean_opacity;
     EXPECT_EQ(reset, i == 15) << "after iteration " << i << ": " << now.mean_opacity << " -> "
