@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/progress.hpp"
 #include "io/image.hpp"
+#include "io/image_jobs.hpp"
 #include "io/image_tensor.hpp"
 #include "priors/depth/depth_files.hpp"
 #include "priors/depth/depth_net.hpp"
@@ -29,6 +30,7 @@ void run_depth(const DepthArgs& args) {
   using priors::depth::DepthJob;
   use_device(args.device);
   const std::vector<DepthJob> jobs = priors::depth::plan_depth_jobs(args.in, args.out);
+  const auto lock = lock_results_folder(args.in, args.out);
   const std::unique_ptr<priors::depth::DepthNet> net =
       priors::depth::make_depth_net(args.model, args.weights);
   if (!net) fail("depth: model '{}' predicts nothing, so there is nothing to write", args.model);

@@ -74,6 +74,7 @@ std::pair<int, int> upscale_one(SrNet& net, const UpscaleArgs& args, const Image
 void run(const UpscaleArgs& args) {
   use_device(args.device);
   const std::vector<ImageJob> jobs = plan_jobs(args.input, args.output);
+  const auto lock = lock_results_folder(args.input, args.output);
   const std::unique_ptr<SrNet> net = priors::sr::make_sr_net(args.model, args.weights, args.scale);
   ItemPace pace(jobs.size());
   for (size_t i = 0; i < jobs.size(); ++i) {

@@ -53,4 +53,9 @@ void refuse_overwrites(const std::vector<ImageJob>& jobs) {
     }
 }
 
+std::unique_ptr<FolderLock> lock_results_folder(const fs::path& input, const fs::path& output) {
+  if (!fs::is_directory(input)) return nullptr;
+  return std::make_unique<FolderLock>(output);
+}
+
 }  // namespace iesrgs

@@ -1,8 +1,11 @@
 #pragma once
 // Which files a command over "an image or a folder of images" (upscale, depth) reads and writes.
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "io/folder_lock.hpp"
 
 namespace iesrgs {
 
@@ -25,5 +28,10 @@ std::vector<ImageJob> plan_image_jobs(const std::filesystem::path& input,
 // images sharing a stem (a.png, a.jpg), or results written into the input folder, would
 // otherwise overwrite results or inputs without a word.
 void refuse_overwrites(const std::vector<ImageJob>& jobs);
+
+// Holds `output` against other writers while the jobs run (FolderLock) when `input` is a folder,
+// whose results fill it, so that two commands never mix their results there; null for an image.
+std::unique_ptr<FolderLock> lock_results_folder(const std::filesystem::path& input,
+                                                const std::filesystem::path& output);
 
 }  // namespace iesrgs
