@@ -11,10 +11,13 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/torch_error.hpp"
+#include "io/atomic_file.hpp"
 
 int main(int argc, char** argv) {
   // Progress reaches a pipe or a log as each line is printed, and a killed command keeps it.
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  // Ctrl-C outside training ends a command at once, without the file it was writing.
+  iesrgs::end_on_signals(iesrgs::remove_temporaries_in_progress);
   CLI::App app{"iesrgs: super-resolution 3D Gaussian Splatting (IE-SRGS) on CPUs and GPUs"};
   // LibTorch's CPU ops (the networks) default to one thread here; give them the cores OpenMP
   // uses for our own kernels (OMP_NUM_THREADS still limits both).

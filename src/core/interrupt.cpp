@@ -1,5 +1,7 @@
 #include "core/interrupt.hpp"
 
+#include <unistd.h>
+
 #include <atomic>
 #include <csignal>
 
@@ -12,9 +14,20 @@ namespace {
 std::atomic<int> received{0};  // the signal that asked, 0 while none did
 int open_scopes = 0;           // scopes are made by the main thread only
 
+void (*exit_cleanup)() = nullptr;
+
+extern "C" void end_now(int signal) {
+  if (exit_cleanup) exit_cleanup();
+  static constexpr char kMessage[] =
+      "\ninterrupted: stopped before the end; no half-written file is left\n";
+  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+  std::signal(signal, SIG_DFL);
+  std::raise(signal);  // delivered as the handler returns: the process ends as the signal ends it
+}
+
 extern "C" void request_interrupt(int signal) {
   received = signal;
-  std::signal(signal, SIG_DFL);  // a second Ctrl-C stops at once
+  std::signal(signal, end_now);  // a second Ctrl-C stops at once
 }
 
 }  // namespace
@@ -28,9 +41,15 @@ InterruptScope::InterruptScope() {
 InterruptScope::~InterruptScope() {
   // Inside an outer scope after a request, the outer handlers would catch a second signal too.
   const bool asked_inside = interrupt_requested() && open_scopes > 1;
-  std::signal(SIGINT, asked_inside ? SIG_DFL : previous_int_);
-  std::signal(SIGTERM, asked_inside ? SIG_DFL : previous_term_);
+  std::signal(SIGINT, asked_inside ? end_now : previous_int_);
+  std::signal(SIGTERM, asked_inside ? end_now : previous_term_);
   --open_scopes;
+}
+
+void end_on_signals(void (*cleanup)()) {
+  exit_cleanup = cleanup;
+  std::signal(SIGINT, end_now);
+  std::signal(SIGTERM, end_now);
 }
 
 bool interrupt_requested() {

@@ -1,7 +1,7 @@
 #pragma once
 // SIGINT (Ctrl-C) and SIGTERM (kill, timeout, docker stop) ask long work to stop at its next safe
-// point, while an InterruptScope is alive; outside one they end the process as usual. A second
-// signal ends it at once.
+// point, while an InterruptScope is alive; outside one they end the process as the signal does
+// (after end_on_signals' cleanup, once it is set). A second signal ends it at once.
 #include <string>
 
 namespace iesrgs {
@@ -19,6 +19,11 @@ class InterruptScope {
   void (*previous_int_)(int);
   void (*previous_term_)(int);
 };
+
+// From now on a signal that no InterruptScope catches, and a second one inside a scope, ends the
+// process as the signal would (status 130 or 143), after `cleanup` and a line on stderr saying so.
+// `cleanup` runs in the signal handler: it may only make async-signal-safe calls.
+void end_on_signals(void (*cleanup)());
 
 // Whether a signal asked the work to stop.
 bool interrupt_requested();

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <fstream>
@@ -21,6 +22,33 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr std::string_view kTemporaryMark = ".tmp-";
+constexpr int kStaleSearchDepth = 4;  // levels of subfolders searched below the folder
+
+// The temporaries being written, for a signal handler to remove: slots of plain atomic pointers,
+// which a handler may read, to names that outlive their registration.
+std::array<std::atomic<const char*>, 64> in_progress{};
+
+// Lists a temporary in `in_progress` while it is written; one beyond the slots is not listed.
+class InProgress {
+ public:
+  explicit InProgress(const char* name) {
+    for (auto& slot : in_progress) {
+      const char* empty = nullptr;
+      if (slot.compare_exchange_strong(empty, name)) {
+        slot_ = &slot;
+        return;
+      }
+    }
+  }
+  ~InProgress() {
+    if (slot_) *slot_ = nullptr;
+  }
+  InProgress(const InProgress&) = delete;
+  InProgress& operator=(const InProgress&) = delete;
+
+ private:
+  std::atomic<const char*>* slot_ = nullptr;
+};
 
 fs::path temporary_path(const fs::path& path) {
   return path.string() + std::string(kTemporaryMark) + std::to_string(::getpid());
@@ -55,6 +83,8 @@ void write_atomically(const fs::path& path, const std::function<void(const fs::p
     if (ec) fail_file(path.parent_path(), "cannot create directory: " + ec.message());
   }
   const fs::path tmp = temporary_path(path);
+  const std::string tmp_name = tmp.string();
+  const InProgress listed(tmp_name.c_str());
   try {
     write(tmp);
     fs::rename(tmp, path, ec);
@@ -67,10 +97,19 @@ void write_atomically(const fs::path& path, const std::function<void(const fs::p
 
 void remove_stale_temporaries(const fs::path& folder) {
   std::error_code walk;
-  for (fs::directory_iterator it(folder, walk), end; !walk && it != end; it.increment(walk)) {
+  for (fs::recursive_directory_iterator
+           it(folder, fs::directory_options::skip_permission_denied, walk),
+       end;
+       !walk && it != end; it.increment(walk)) {
     std::error_code ec;  // an entry that cannot be checked or removed is left alone
+    if (it->is_directory(ec) && it.depth() >= kStaleSearchDepth) it.disable_recursion_pending();
     if (it->is_regular_file(ec) && is_stale_temporary(it->path())) fs::remove(it->path(), ec);
   }
+}
+
+void remove_temporaries_in_progress() {
+  for (const auto& slot : in_progress)
+    if (const char* name = slot.load()) ::unlink(name);
 }
 
 void write_file_atomically(const fs::path& path, const std::string& bytes) {

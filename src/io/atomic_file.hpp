@@ -16,9 +16,14 @@ void write_atomically(const std::filesystem::path& path,
 // Atomic text / binary file writes.
 void write_file_atomically(const std::filesystem::path& path, const std::string& bytes);
 
-// Removes the temporaries that processes killed mid-write (a second Ctrl-C, kill -9, the OOM
-// killer) left in `folder` (not below it): those of our outputs' kinds whose writer is gone.
+// Removes the temporaries that processes killed mid-write (kill -9, the OOM killer) left in
+// `folder` and its subfolders down to four levels (a run's rows/<row>/test/rgb/): those of our
+// outputs' kinds whose writer is gone.
 void remove_stale_temporaries(const std::filesystem::path& folder);
+
+// Removes the temporaries this process is writing now. Async-signal-safe: for the handler that
+// ends the process on a signal (end_on_signals), so that Ctrl-C leaves no half-written file.
+void remove_temporaries_in_progress();
 
 // Removes `file`, an earlier output about to be replaced, when it exists; returns whether it did.
 // Throws Error naming the file when it cannot be removed, saying what left it (`left_by`, e.g.

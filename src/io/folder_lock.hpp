@@ -13,7 +13,7 @@ namespace iesrgs {
 // folders up to three levels below it. On a file system without locks, the folder is used
 // unlocked. Folders it created that are still empty when it is released are removed, so a
 // command refused after taking the lock leaves no trace. Taking it removes the temporaries a
-// killed writer left in the folder (remove_stale_temporaries).
+// killed writer left in the folder and below (remove_stale_temporaries).
 class FolderLock {
  public:
   explicit FolderLock(const std::filesystem::path& folder);

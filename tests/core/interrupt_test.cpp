@@ -2,16 +2,35 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
 #include <optional>
 
 #include "core/error.hpp"
 #include "support/expect_error.hpp"
+#include "support/temp_dir.hpp"
 
 namespace iesrgs {
 namespace {
 
 using testing::error_message;
+
+// The signal that ended a child process running `work`, 0 when it ended normally.
+int ended_by(const std::function<void()>& work) {
+  const pid_t child = ::fork();
+  if (child == 0) {
+    work();
+    ::_exit(0);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+}
 
 TEST(Interrupt, ASignalInsideAScopeAsksTheWorkToStop) {
   const InterruptScope scope;
@@ -25,6 +44,32 @@ TEST(Interrupt, ASignalInsideAScopeAsksTheWorkToStop) {
             "rendering stopped; run the same command again to resume");
 }
 
+// Outside a scope, a signal ends the process as it would have, after the cleanup; inside one, only
+// a second signal does.
+TEST(Interrupt, EndOnSignalsEndsTheProcessAfterTheCleanup) {
+  static char marker[256];
+  testing::TempDir dir;
+  std::snprintf(marker, sizeof marker, "%s", (dir / "marker").c_str());
+  std::FILE* file = std::fopen(marker, "w");
+  ASSERT_NE(file, nullptr);
+  std::fclose(file);
+  const auto cleanup = [] { ::unlink(marker); };
+  EXPECT_EQ(ended_by([&] {
+              end_on_signals(cleanup);
+              std::raise(SIGTERM);
+            }),
+            SIGTERM);
+  EXPECT_FALSE(std::filesystem::exists(marker));
+  EXPECT_EQ(ended_by([&] {
+              end_on_signals(cleanup);
+              const InterruptScope scope;
+              std::raise(SIGTERM);  // asks
+              if (!interrupt_requested()) ::_exit(3);
+              std::raise(SIGTERM);  // ends
+            }),
+            SIGTERM);
+}
+
 // The trainer's scope inside a run's: a Ctrl-C the run got before training began still counts.
 TEST(Interrupt, AnInnerScopeKeepsTheOuterScopesRequest) {
   std::optional<InterruptScope> outer(std::in_place);
@@ -35,7 +80,7 @@ TEST(Interrupt, AnInnerScopeKeepsTheOuterScopesRequest) {
     EXPECT_EQ(interrupt_exit_status(), 128 + SIGINT);
   }
   // A second signal would now end the process, not be caught by the outer scope's handler.
-  EXPECT_EQ(std::signal(SIGINT, SIG_DFL), SIG_DFL);
+  EXPECT_EQ(ended_by([] { std::raise(SIGINT); }), SIGINT);
   outer.reset();
   const InterruptScope next;  // a new outermost scope starts afresh
   EXPECT_FALSE(interrupt_requested());

@@ -62,17 +62,20 @@ TEST(FolderLock, FoldersItCreatedAndLeftEmptyAreRemoved) {
   EXPECT_TRUE(std::filesystem::is_directory(dir / "given"));  // the user's own folder stays
 }
 
-// A writer killed mid-write leaves "<name>.tmp-<pid>". Only our outputs' temporaries in the
-// folder itself go, and only when their writer is gone (no process has a pid of 999999999).
+// A writer killed mid-write leaves "<name>.tmp-<pid>". Only our outputs' temporaries go, in the
+// folder and four levels of subfolders (a run's rows/<row>/test/rgb/), and only when their writer
+// is gone (no process has a pid of 999999999).
 TEST(FolderLock, TakingItRemovesWhatKilledWritersLeft) {
   TempDir dir;
-  std::filesystem::create_directories(dir / "run" / "rows");
-  const char* files[] = {"checkpoint.pt.tmp-999999999", "rows/r_0.png.tmp-999999999",
-                         "notes.tmp-999999999", "draft.png.tmp-x"};
+  std::filesystem::create_directories(dir / "run" / "rows/ie-srgs/test/rgb/deeper");
+  const char* files[] = {"checkpoint.pt.tmp-999999999",
+                         "rows/ie-srgs/test/rgb/r_0.png.tmp-999999999", "notes.tmp-999999999",
+                         "draft.png.tmp-x", "rows/ie-srgs/test/rgb/deeper/r_1.png.tmp-999999999"};
   for (const char* name : files) std::ofstream(dir / "run" / name) << "x";
   FolderLock lock(dir / "run");
-  EXPECT_FALSE(std::filesystem::exists(dir / "run" / files[0]));
-  for (const char* kept : {files[1], files[2], files[3]})
+  for (const char* gone : {files[0], files[1]})
+    EXPECT_FALSE(std::filesystem::exists(dir / "run" / gone)) << gone;
+  for (const char* kept : {files[2], files[3], files[4]})
     EXPECT_TRUE(std::filesystem::exists(dir / "run" / kept)) << kept;
 }
 

@@ -1,0 +1,60 @@
+#include "io/atomic_file.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+
+#include "core/interrupt.hpp"
+#include "support/temp_dir.hpp"
+
+namespace iesrgs {
+namespace {
+
+using testing::TempDir;
+
+namespace fs = std::filesystem;
+
+// What the signal handler removes: the temporary being written, under its own name.
+TEST(AtomicFile, TheTemporaryBeingWrittenIsListedForRemoval) {
+  TempDir dir;
+  fs::path written;
+  EXPECT_ANY_THROW(write_atomically(dir / "out.ply", [&](const fs::path& tmp) {
+    std::ofstream(tmp) << "half";
+    written = tmp;
+    remove_temporaries_in_progress();
+    EXPECT_FALSE(fs::exists(tmp));
+    throw std::runtime_error("stop");
+  }));
+  EXPECT_NE(written.filename().string().find("out.ply.tmp-"), std::string::npos);
+  write_file_atomically(dir / "done.json", "{}");
+  remove_temporaries_in_progress();  // nothing is in progress: finished files stay
+  EXPECT_TRUE(fs::exists(dir / "done.json"));
+}
+
+// Ctrl-C while a file is written, outside training: the process ends as the signal ends it, and
+// neither the file nor its temporary is left.
+TEST(AtomicFile, ASignalMidWriteLeavesNoHalfWrittenFile) {
+  TempDir dir;
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    end_on_signals(remove_temporaries_in_progress);
+    write_atomically(dir / "model.ply", [](const fs::path& tmp) {
+      std::ofstream(tmp) << "half";
+      std::raise(SIGINT);
+    });
+    ::_exit(0);  // not reached
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status)) << status;
+  EXPECT_EQ(WTERMSIG(status), SIGINT);
+  EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+}  // namespace
+}  // namespace iesrgs
