@@ -1,11 +1,11 @@
 #include "io/image.hpp"
 
-#include <stb/stb_image.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -16,6 +16,20 @@
 #include "core/paths.hpp"
 #include "io/atomic_file.hpp"
 #include "io/mapped_file.hpp"
+
+// stb_image built here rather than taken from libstb, for two reasons. Only its PNG and JPEG
+// decoders: TGA has no signature, so libstb read any unrecognised file as one, and a 20-byte file
+// claiming 46000x46000 pixels cost 4 GB before anything could refuse it. And zeroed allocations:
+// a progressive JPEG naming a Huffman table no marker defined makes stb 2.27 read that table
+// uninitialised.
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_PNG
+#define STBI_ONLY_JPEG
+#define STBI_MALLOC(size) std::calloc(1, size)
+#define STBI_REALLOC(pointer, size) std::realloc(pointer, size)
+#define STBI_FREE(pointer) std::free(pointer)
+#include <stb/stb_image.h>
 
 namespace iesrgs {
 
@@ -28,6 +42,9 @@ void require_readable(const fs::path& path) {
   if (!fs::exists(path, ec)) fail_file(path, "image not found");
   if (fs::is_directory(path, ec)) fail_file(path, "is a directory, expected an image");
 }
+
+constexpr double kMostPixelsPerByte = 16384;
+constexpr double kAnySmallImage = 1 << 20;  // pixels: headers and tables weigh in small files
 
 std::string decode_problem() {
   const int open_error = errno;  // what stb's fopen left, before anything here changes it
@@ -161,10 +178,17 @@ Image8 read_image8(const fs::path& path) {
   if (bytes.size() > size_t(std::numeric_limits<int>::max()))
     fail_file(path, "not a readable PNG/JPEG (over 2 GiB)");
   int w = 0, h = 0, c = 0;
+  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
+  // A header can claim any size; deflate and JPEG's entropy coding cannot pack more than some
+  // thousand pixels into a byte (8256 for a 1-bit PNG of one colour), so a claim far beyond that
+  // is damage, refused before stb allocates for it.
+  if (stbi_info_from_memory(data, int(bytes.size()), &w, &h, &c) &&
+      double(w) * double(h) > kMostPixelsPerByte * double(bytes.size()) + kAnySmallImage)
+    fail_file(path, fmt::format("damaged: its header claims {}x{} pixels, more than its {} bytes "
+                                "can hold",
+                                w, h, bytes.size()));
   std::unique_ptr<stbi_uc, void (*)(void*)> pixels(
-      stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size()), &w,
-                            &h, &c, 0),
-      stbi_image_free);
+      stbi_load_from_memory(data, int(bytes.size()), &w, &h, &c, 0), stbi_image_free);
   if (!pixels) fail_file(path, decode_problem());
   Image8 image(w, h, c);
   std::memcpy(image.data.data(), pixels.get(), image.data.size());

@@ -1,5 +1,4 @@
 #include <gtest/gtest.h>
-#include <stb/stb_image.h>
 #include <zlib.h>
 
 #include "io/atomic_file.hpp"
@@ -7,12 +6,29 @@
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
+// A decoder of its own for the 16-bit PNGs, which the project never reads back.
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_PNG
+#include <stb/stb_image.h>
+
 namespace iesrgs {
 namespace {
 
 using testing::error_message;
 using testing::TempDir;
 using testing::write_text;
+
+// `png` with its header's size replaced, and the header's CRC made right for it.
+std::string with_size(std::string png, uint32_t width, uint32_t height) {
+  for (int k = 0; k < 4; ++k) {
+    png[16 + k] = char(width >> (24 - 8 * k));
+    png[20 + k] = char(height >> (24 - 8 * k));
+  }
+  const uLong crc = crc32(0, reinterpret_cast<const Bytef*>(png.data() + 12), 17);
+  for (int k = 0; k < 4; ++k) png[29 + k] = char(crc >> (24 - 8 * k));
+  return png;
+}
 
 Image8 gradient(int w, int h, int c) {
   Image8 image(w, h, c);
@@ -107,7 +123,11 @@ TEST(Image, CorruptFilesAreNamed) {
   write_text(dir / "truncated.png", png.substr(0, png.size() / 2));
   write_text(dir / "garbage.jpg", "this is not a JPEG at all");
   write_text(dir / "empty.png", "");
-  for (const char* name : {"truncated.png", "garbage.jpg", "empty.png"}) {
+  // A run-length TGA header claiming 46000x46000 pixels: TGA, which has no signature, is not an
+  // image format read here, so no file of another kind decodes as one.
+  write_text(dir / "tga.png",
+             std::string("\0\0\x0a\0\0\0\0\0\0\0\0\0\xb0\xb3\xb0\xb3\x18\0\0\0", 20));
+  for (const char* name : {"truncated.png", "garbage.jpg", "empty.png", "tga.png"}) {
     const std::string message = error_message([&] { read_image8(dir / name); });
     EXPECT_NE(message.find(std::string(name) + ": not a readable PNG/JPEG"), std::string::npos)
         << message;
@@ -130,16 +150,18 @@ TEST(Image, APngWhoseDataFailsItsCrcIsDamaged) {
   // stb wants the end chunk, and says nothing of why: the message does.
   EXPECT_EQ(error_message([&] { read_image8(dir / "no_end.png"); }),
             (dir / "no_end.png").string() + ": not a readable PNG/JPEG (damaged or truncated)");
-  // A header claiming 2^25 pixels a side (its CRC right): stb's bare "too large" is explained.
-  std::string huge = read_file(dir / "ok.png");
-  huge.replace(16, 4, std::string("\x02\0\0\0", 4));  // IHDR's width
-  const uLong crc = crc32(0, reinterpret_cast<const Bytef*>(huge.data() + 12), 17);
-  for (int k = 0; k < 4; ++k) huge[29 + k] = char(crc >> (24 - 8 * k));
-  write_text(dir / "huge.png", huge);
+  // A header claiming 2^25 pixels a side: stb's bare "too large" is explained.
+  write_text(dir / "huge.png", with_size(read_file(dir / "ok.png"), 1 << 25, 64));
   EXPECT_NE(error_message([&] {
               read_image8(dir / "huge.png");
             }).find("too large to decode: more than 16777216 pixels a side"),
             std::string::npos);
+  // 15000x15000 pixels in some hundred bytes: refused before stb allocates 675 MB for them.
+  const std::string claimed = with_size(read_file(dir / "ok.png"), 15000, 15000);
+  write_text(dir / "claims.png", claimed);
+  EXPECT_EQ(error_message([&] { read_image8(dir / "claims.png"); }),
+            (dir / "claims.png").string() + ": damaged: its header claims 15000x15000 pixels, " +
+                "more than its " + std::to_string(claimed.size()) + " bytes can hold");
   // A text chunk, which stb skips, with a wrong CRC: libpng warns and reads the image, as here.
   std::string text = read_file(dir / "ok.png");
   text.insert(33, std::string("\0\0\0\5tEXta\0bcd\0\0\0\0", 17));  // after IHDR
