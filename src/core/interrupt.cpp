@@ -19,10 +19,19 @@ void (*exit_cleanup)() = nullptr;
 extern "C" void end_now(int signal) {
   if (exit_cleanup) exit_cleanup();
   static constexpr char kMessage[] =
-      "\ninterrupted: stopped before the end; no half-written file is left\n";
+      "\ninterrupted: stopped before the end; the files being written were removed\n";
   [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
   std::signal(signal, SIG_DFL);
   std::raise(signal);  // delivered as the handler returns: the process ends as the signal ends it
+}
+
+// Installs `handler` for `signal` and returns the one it replaces, but leaves a signal the caller
+// ignores ignored: a shell starts a script's `command &` so, so that Ctrl-C reaches only the
+// script's foreground.
+void (*catch_signal(int signal, void (*handler)(int)))(int) {
+  struct sigaction current {};
+  if (::sigaction(signal, nullptr, &current) == 0 && current.sa_handler == SIG_IGN) return SIG_IGN;
+  return std::signal(signal, handler);
 }
 
 extern "C" void request_interrupt(int signal) {
@@ -34,8 +43,8 @@ extern "C" void request_interrupt(int signal) {
 
 InterruptScope::InterruptScope() {
   if (open_scopes++ == 0) received = 0;
-  previous_int_ = std::signal(SIGINT, request_interrupt);
-  previous_term_ = std::signal(SIGTERM, request_interrupt);
+  previous_int_ = catch_signal(SIGINT, request_interrupt);
+  previous_term_ = catch_signal(SIGTERM, request_interrupt);
 }
 
 InterruptScope::~InterruptScope() {
@@ -48,8 +57,8 @@ InterruptScope::~InterruptScope() {
 
 void end_on_signals(void (*cleanup)()) {
   exit_cleanup = cleanup;
-  std::signal(SIGINT, end_now);
-  std::signal(SIGTERM, end_now);
+  catch_signal(SIGINT, end_now);
+  catch_signal(SIGTERM, end_now);
 }
 
 bool interrupt_requested() {

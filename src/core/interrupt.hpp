@@ -22,7 +22,8 @@ class InterruptScope {
 
 // From now on a signal that no InterruptScope catches, and a second one inside a scope, ends the
 // process as the signal would (status 130 or 143), after `cleanup` and a line on stderr saying so.
-// `cleanup` runs in the signal handler: it may only make async-signal-safe calls.
+// `cleanup` runs in the signal handler: it may only make async-signal-safe calls. A signal the
+// process was started ignoring (a script's `command &`) stays ignored, here and by the scopes.
 void end_on_signals(void (*cleanup)());
 
 // Whether a signal asked the work to stop.

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <string_view>
 #include <system_error>
@@ -24,30 +25,41 @@ namespace {
 constexpr std::string_view kTemporaryMark = ".tmp-";
 constexpr int kStaleSearchDepth = 4;  // levels of subfolders searched below the folder
 
-// The temporaries being written, for a signal handler to remove: slots of plain atomic pointers,
-// which a handler may read, to names that outlive their registration.
-std::array<std::atomic<const char*>, 64> in_progress{};
+// The temporaries being written, for a signal handler to remove. Each slot keeps its own copy of
+// the name, so that a handler on another thread only ever reads a temporary's name, never memory
+// its writer has freed.
+struct InProgressSlot {
+  std::atomic<bool> taken{false};
+  std::atomic<bool> listed{false};  // `name` is complete
+  char name[4096];
+};
+std::array<InProgressSlot, 64> in_progress;
 
-// Lists a temporary in `in_progress` while it is written; one beyond the slots is not listed.
+// Lists a temporary in `in_progress` while it is written; one beyond the slots, or with a longer
+// name, is not listed (the next command taking its folder removes it).
 class InProgress {
  public:
-  explicit InProgress(const char* name) {
-    for (auto& slot : in_progress) {
-      const char* empty = nullptr;
-      if (slot.compare_exchange_strong(empty, name)) {
-        slot_ = &slot;
-        return;
-      }
+  explicit InProgress(const std::string& name) {
+    if (name.size() >= sizeof(InProgressSlot::name)) return;
+    for (InProgressSlot& slot : in_progress) {
+      bool free = false;
+      if (!slot.taken.compare_exchange_strong(free, true)) continue;
+      std::memcpy(slot.name, name.c_str(), name.size() + 1);
+      slot.listed = true;
+      slot_ = &slot;
+      return;
     }
   }
   ~InProgress() {
-    if (slot_) *slot_ = nullptr;
+    if (!slot_) return;
+    slot_->listed = false;
+    slot_->taken = false;
   }
   InProgress(const InProgress&) = delete;
   InProgress& operator=(const InProgress&) = delete;
 
  private:
-  std::atomic<const char*>* slot_ = nullptr;
+  InProgressSlot* slot_ = nullptr;
 };
 
 fs::path temporary_path(const fs::path& path) {
@@ -83,8 +95,7 @@ void write_atomically(const fs::path& path, const std::function<void(const fs::p
     if (ec) fail_file(path.parent_path(), "cannot create directory: " + ec.message());
   }
   const fs::path tmp = temporary_path(path);
-  const std::string tmp_name = tmp.string();
-  const InProgress listed(tmp_name.c_str());
+  const InProgress listed(tmp.string());
   try {
     write(tmp);
     fs::rename(tmp, path, ec);
@@ -108,8 +119,8 @@ void remove_stale_temporaries(const fs::path& folder) {
 }
 
 void remove_temporaries_in_progress() {
-  for (const auto& slot : in_progress)
-    if (const char* name = slot.load()) ::unlink(name);
+  for (const InProgressSlot& slot : in_progress)
+    if (slot.listed) ::unlink(slot.name);
 }
 
 void write_file_atomically(const fs::path& path, const std::string& bytes) {

@@ -45,29 +45,50 @@ TEST(Interrupt, ASignalInsideAScopeAsksTheWorkToStop) {
 }
 
 // Outside a scope, a signal ends the process as it would have, after the cleanup; inside one, only
-// a second signal does.
+// a second signal does, also after leaving a nested scope. A signal ignored from the start stays
+// ignored.
 TEST(Interrupt, EndOnSignalsEndsTheProcessAfterTheCleanup) {
   static char marker[256];
   testing::TempDir dir;
   std::snprintf(marker, sizeof marker, "%s", (dir / "marker").c_str());
-  std::FILE* file = std::fopen(marker, "w");
-  ASSERT_NE(file, nullptr);
-  std::fclose(file);
-  const auto cleanup = [] { ::unlink(marker); };
-  EXPECT_EQ(ended_by([&] {
-              end_on_signals(cleanup);
-              std::raise(SIGTERM);
-            }),
-            SIGTERM);
-  EXPECT_FALSE(std::filesystem::exists(marker));
-  EXPECT_EQ(ended_by([&] {
-              end_on_signals(cleanup);
-              const InterruptScope scope;
-              std::raise(SIGTERM);  // asks
-              if (!interrupt_requested()) ::_exit(3);
-              std::raise(SIGTERM);  // ends
-            }),
-            SIGTERM);
+  const auto cleaned_up = [&](const std::function<void()>& work, int signal) {
+    std::FILE* file = std::fopen(marker, "w");
+    if (file) std::fclose(file);
+    EXPECT_EQ(ended_by([&] {
+                end_on_signals([] { ::unlink(marker); });
+                work();
+              }),
+              signal);
+    return !std::filesystem::exists(marker);
+  };
+  EXPECT_TRUE(cleaned_up([] { std::raise(SIGTERM); }, SIGTERM));
+  EXPECT_TRUE(cleaned_up(
+      [] {
+        const InterruptScope scope;
+        std::raise(SIGTERM);  // asks
+        if (!interrupt_requested()) ::_exit(3);
+        std::raise(SIGTERM);  // ends
+      },
+      SIGTERM));
+  EXPECT_TRUE(cleaned_up(
+      [] {
+        const InterruptScope outer;
+        {
+          const InterruptScope inner;
+          std::raise(SIGINT);
+        }
+        std::raise(SIGINT);  // the second, after the inner scope gave its handler back
+      },
+      SIGINT));
+  EXPECT_FALSE(cleaned_up(
+      [] {
+        std::signal(SIGINT, SIG_IGN);  // as a shell starts `command &` in a script
+        end_on_signals([] { ::unlink(marker); });
+        const InterruptScope scope;
+        std::raise(SIGINT);
+        if (interrupt_requested()) ::_exit(3);
+      },
+      0));
 }
 
 // The trainer's scope inside a run's: a Ctrl-C the run got before training began still counts.
