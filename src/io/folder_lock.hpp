@@ -10,7 +10,7 @@ namespace iesrgs {
 // Creates `folder` if needed and holds an exclusive lock on it until destroyed. The kernel
 // drops the lock when the process ends, however it ends, so a crash leaves nothing stale.
 // Throws Error naming the folder when another process holds it, a folder above it or one of the
-// folders up to three levels below it. On a file system without locks, the folder is used
+// folders up to four levels below it. On a file system without locks, the folder is used
 // unlocked. Folders it created that are still empty when it is released are removed, so a
 // command refused after taking the lock leaves no trace. Taking it removes the temporaries a
 // killed writer left in the folder and below (remove_stale_temporaries).
