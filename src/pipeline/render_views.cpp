@@ -174,9 +174,10 @@ double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel
   }
   if (clamped)
     fmt::print(
-        "note: {} pixels lie farther than {} scene units, the most a 16-bit depth PNG "
-        "holds at x{}; depth/*.npy keeps their depth\n",
-        clamped, 65535 / kDepthPngScale, kDepthPngScale);
+        "note: {} {} farther than {} scene units, the most a 16-bit depth PNG holds at x{}; "
+        "depth/*.npy keeps their depth\n",
+        clamped, clamped == 1 ? "pixel lies" : "pixels lie", 65535 / kDepthPngScale,
+        kDepthPngScale);
   return cameras.empty() ? 0 : render_seconds / double(cameras.size());
 }
 

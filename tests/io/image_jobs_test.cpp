@@ -52,5 +52,22 @@ TEST(ImageJobs, ResultsNeverOverwriteAnInputNorEachOther) {
                 "; rename one");
 }
 
+// A folder of images fills a folder of results, which is held while they are written; a single
+// image's result is not.
+TEST(ImageJobs, AFolderOfResultsIsHeldWhileTheJobsRun) {
+  TempDir dir;
+  std::filesystem::create_directories(dir / "in");
+  write_text(dir / "in" / "a.png", "x");
+  {
+    const auto lock = lock_results_folder(dir / "in", dir / "out");
+    ASSERT_NE(lock, nullptr);
+    EXPECT_NE(
+        error_message([&] { FolderLock again(dir / "out"); }).find("in use by another process"),
+        std::string::npos);
+  }
+  EXPECT_EQ(lock_results_folder(dir / "in" / "a.png", dir / "out.png"), nullptr);
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.png"));
+}
+
 }  // namespace
 }  // namespace iesrgs

@@ -17,7 +17,9 @@ using testing::TempDir;
 
 // Rewrites are told by the file's time: an old one set beforehand, so that a rewrite within the
 // file system's clock tick still shows.
-const auto kOld = std::filesystem::file_time_type::clock::now() - std::chrono::hours(48);
+// Whole seconds, which every file system stores as they are.
+const auto kOld = std::chrono::floor<std::chrono::seconds>(
+    std::filesystem::file_time_type::clock::now() - std::chrono::hours(48));
 
 void mark_old(const std::filesystem::path& file) {
   std::filesystem::last_write_time(file, kOld);
