@@ -66,14 +66,17 @@ uint32_t big_endian32(std::string_view bytes, size_t at) {
 // stb decodes a PNG without checking its chunks' CRCs, so a flipped byte of the pixel data would
 // decode into other pixels without a word. As libpng does, a chunk the image needs (a critical
 // one: its type starts upper-case; and tRNS, which stb reads) is refused when its CRC fails;
-// other ancillary chunks, which stb skips, are not checked. Chunks cut off by the end of the
-// file are left to the decoder, which names the truncation.
+// other ancillary chunks, which stb skips, are not checked. A chunk reaching past the end of the
+// file is refused too: stb would first allocate the length it claims, up to 4 GB.
 void check_png_crcs(std::string_view bytes, const fs::path& path) {
   constexpr std::string_view kSignature = "\x89PNG\r\n\x1a\n";
   if (bytes.substr(0, kSignature.size()) != kSignature) return;
   for (size_t at = kSignature.size(); at + 12 <= bytes.size();) {
     const uint64_t length = big_endian32(bytes, at);
-    if (at + 12 + length > bytes.size()) return;
+    if (at + 12 + length > bytes.size())
+      fail_file(path, fmt::format("not a readable PNG/JPEG (truncated: its chunk {} at byte {} "
+                                  "claims {} bytes, past the end of the file)",
+                                  bytes.substr(at + 4, 4), at, length));
     const std::string_view typed = bytes.substr(at + 4, 4 + length);  // the type and the data
     const std::string_view type = typed.substr(0, 4);
     const bool needed = (type[0] & 0x20) == 0 || type == "tRNS";

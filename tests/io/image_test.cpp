@@ -162,6 +162,15 @@ TEST(Image, APngWhoseDataFailsItsCrcIsDamaged) {
   EXPECT_EQ(error_message([&] { read_image8(dir / "claims.png"); }),
             (dir / "claims.png").string() + ": damaged: its header claims 15000x15000 pixels, " +
                 "more than its " + std::to_string(claimed.size()) + " bytes can hold");
+  // A chunk claiming 1.1 GB in a file of some hundred bytes: refused before stb allocates them.
+  std::string long_chunk = read_file(dir / "ok.png");
+  const size_t idat = long_chunk.find("IDAT") - 4;
+  long_chunk.replace(idat, 4, "DIDA");
+  write_text(dir / "long_chunk.png", long_chunk);
+  EXPECT_EQ(error_message([&] { read_image8(dir / "long_chunk.png"); }),
+            (dir / "long_chunk.png").string() +
+                ": not a readable PNG/JPEG (truncated: its chunk IDAT at byte " +
+                std::to_string(idat) + " claims 1145652289 bytes, past the end of the file)");
   // A text chunk, which stb skips, with a wrong CRC: libpng warns and reads the image, as here.
   std::string text = read_file(dir / "ok.png");
   text.insert(33, std::string("\0\0\0\5tEXta\0bcd\0\0\0\0", 17));  // after IHDR
