@@ -174,11 +174,8 @@ std::optional<std::string> lpips_unavailable_reason(LpipsNet net, const LpipsWei
 // The backbone and the heads are separate modules because each loads strictly from its own file.
 struct Lpips::Networks {
   explicit Networks(LpipsNet net)
-      : features(backbone->register_module("features", spec(net).features())),
-        taps(spec(net).taps),
-        min_size(spec(net).min_size),
-        signed_input(spec(net).signed_input) {
-    for (size_t k = 0; k < taps.size(); ++k) {
+      : features(backbone->register_module("features", spec(net).features())), net(net) {
+    for (size_t k = 0; k < spec(net).taps.size(); ++k) {
       // Official layout lin<k>.model = (dropout, 1x1 convolution without bias); dropout is the
       // identity outside training.
       auto lin = heads->register_module("lin" + std::to_string(k), std::make_shared<nn::Module>());
@@ -193,7 +190,7 @@ struct Lpips::Networks {
 
   // Width of the convolution that feeds tap k's ReLU.
   int64_t tap_channels(size_t k) {
-    return features[taps[k] - 1]->as<nn::Conv2d>()->options.out_channels();
+    return features[spec(net).taps[k] - 1]->as<nn::Conv2d>()->options.out_channels();
   }
 
   std::vector<torch::Tensor> tapped_features(const torch::Tensor& input) {
@@ -202,6 +199,7 @@ struct Lpips::Networks {
     size_t index = 0;
     for (auto& layer : *features) {
       x = layer.forward(x);
+      const auto& taps = spec(net).taps;
       if (std::find(taps.begin(), taps.end(), index++) != taps.end()) tapped.push_back(x);
     }
     return tapped;
@@ -211,9 +209,7 @@ struct Lpips::Networks {
   std::shared_ptr<nn::Module> heads = std::make_shared<nn::Module>();
   nn::Sequential features;
   std::vector<nn::Sequential> lin_models;
-  std::array<size_t, 5> taps;
-  int min_size;
-  bool signed_input;
+  LpipsNet net;  // its spec: taps, smallest size and input range
   torch::Device device = torch::kCPU;
 };
 
@@ -233,7 +229,7 @@ Lpips Lpips::from_state_dicts(LpipsNet net, const priors::StateDict& backbone,
 }
 
 int Lpips::min_size() const {
-  return networks_->min_size;
+  return spec(networks_->net).min_size;
 }
 
 void Lpips::to(const torch::Device& device) {
@@ -243,10 +239,10 @@ void Lpips::to(const torch::Device& device) {
 }
 
 float Lpips::distance(const torch::Tensor& a, const torch::Tensor& b) const {
-  check_image_pair(a, b, networks_->min_size);
+  check_image_pair(a, b, spec(networks_->net).min_size);
   torch::NoGradGuard no_grad;
   const auto input = [&](const torch::Tensor& image) {
-    return backbone_input(image, networks_->device, networks_->signed_input);
+    return backbone_input(image, networks_->device, spec(networks_->net).signed_input);
   };
   const auto features_a = networks_->tapped_features(input(a));
   const auto features_b = networks_->tapped_features(input(b));
