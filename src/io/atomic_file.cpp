@@ -23,7 +23,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr std::string_view kTemporaryMark = ".tmp-";
-constexpr int kStaleSearchDepth = 4;  // levels of subfolders searched below the folder
 
 // The temporaries being written, for a signal handler to remove. Each slot keeps its own copy of
 // the name, so that a handler on another thread only ever reads a temporary's name, never memory
@@ -113,7 +112,7 @@ void remove_stale_temporaries(const fs::path& folder) {
        end;
        !walk && it != end; it.increment(walk)) {
     std::error_code ec;  // an entry that cannot be checked or removed is left alone
-    if (it->is_directory(ec) && it.depth() >= kStaleSearchDepth) it.disable_recursion_pending();
+    if (it->is_directory(ec) && it.depth() >= kOutputFolderDepth) it.disable_recursion_pending();
     if (it->is_regular_file(ec) && is_stale_temporary(it->path())) fs::remove(it->path(), ec);
   }
 }

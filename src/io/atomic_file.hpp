@@ -16,9 +16,12 @@ void write_atomically(const std::filesystem::path& path,
 // Atomic text / binary file writes.
 void write_file_atomically(const std::filesystem::path& path, const std::string& bytes);
 
+// Levels of subfolders an output folder's own outputs reach: a run's rows/<row>/test/rgb/.
+constexpr int kOutputFolderDepth = 4;
+
 // Removes the temporaries that processes killed mid-write (kill -9, the OOM killer) left in
-// `folder` and its subfolders down to four levels (a run's rows/<row>/test/rgb/): those of our
-// outputs' kinds whose writer is gone.
+// `folder` and its subfolders down to kOutputFolderDepth levels: those of our outputs' kinds whose
+// writer is gone.
 void remove_stale_temporaries(const std::filesystem::path& folder);
 
 // Removes the temporaries this process is writing now. Async-signal-safe: for the handler that

@@ -49,13 +49,12 @@ void refuse_inside_held_folder(const fs::path& folder) {
 }
 
 // And the other way round: a run must not write over a stage folder that a `train` or `render`
-// is writing. Four levels, as deep as remove_stale_temporaries looks, cover a run's stage
-// folders (rows/<row>/test) and the render folders in them.
+// is writing, down to the folders of its outputs, as deep as remove_stale_temporaries looks.
 void refuse_around_held_folder(const fs::path& folder) {
   std::error_code ec;
   fs::recursive_directory_iterator it(folder, fs::directory_options::skip_permission_denied, ec);
   for (; !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-    if (it.depth() >= 3) it.disable_recursion_pending();
+    if (it.depth() + 1 >= kOutputFolderDepth) it.disable_recursion_pending();
     if (it->is_directory(ec) && !it->is_symlink(ec) && held_elsewhere(it->path()))
       fail_held(folder, "above", it->path());
   }
