@@ -1,6 +1,7 @@
 // SSIM forward and backward on the GPU as separable passes over global memory: a row pass writes
 // each pixel's window statistics along its row, a column pass combines them along the column.
-// Per pixel, the arithmetic is the CPU kernels' (loss/ssim_rows.cpp) in the same order.
+// Per pixel, the arithmetic is the CPU kernels' (loss/ssim_rows.cpp) in the same order; only the
+// GPU's fused multiply-adds round differently.
 #include "loss/cuda/ssim.hpp"
 #include "loss/ssim_point.hpp"
 
