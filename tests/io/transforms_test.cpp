@@ -343,14 +343,14 @@ TEST(NerfstudioScene, CameraModels) {
   EXPECT_DOUBLE_EQ(d.p2, -0.01);
   EXPECT_FALSE(d.beyond_opencv());
 
-  // As nerfstudio: the coefficients apply under either model's name, k3 included.
-  document["camera_model"] = "PINHOLE";
+  // As nerfstudio: the coefficients apply under any perspective model's name, k3 included.
   document["k3"] = 0.02;
-  d = parse_in_memory(document).cameras[0].distortion;
-  EXPECT_DOUBLE_EQ(d.k1, 0.1);
-  EXPECT_DOUBLE_EQ(d.k3, 0.02);
-  document["camera_model"] = "OPENCV";
-  EXPECT_DOUBLE_EQ(parse_in_memory(document).cameras[0].distortion.k3, 0.02);
+  for (const char* model : {"SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV"}) {
+    document["camera_model"] = model;
+    d = parse_in_memory(document).cameras[0].distortion;
+    EXPECT_DOUBLE_EQ(d.k1, 0.1) << model;
+    EXPECT_DOUBLE_EQ(d.k3, 0.02) << model;
+  }
 }
 
 TEST(NerfstudioScene, MissingImageIsAnError) {
