@@ -1,11 +1,14 @@
 #include "io/colmap.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/colmap_codec.hpp"
+#include "io/ply.hpp"
 
 namespace iesrgs {
 
@@ -88,7 +91,9 @@ ColmapModel read_colmap_model(const fs::path& dir) {
   ColmapModel model;
   model.cameras = parse_colmap_cameras(read_file(files.cameras), encoding, files.cameras);
   model.images = parse_colmap_images(read_file(files.images), encoding, files.images);
-  model.points = parse_colmap_points(read_file(files.points), encoding, files.points);
+  std::error_code ec;
+  if (fs::exists(files.points, ec))
+    model.points = parse_colmap_points(read_file(files.points), encoding, files.points);
   check_camera_references(model, files.images);
   return model;
 }
@@ -190,6 +195,18 @@ PointCloud point_cloud_of(const std::vector<ColmapPoint>& points) {
   return cloud;
 }
 
+// As 3DGS, the SfM points start training, and its own points3D.ply (x y z, red green blue) stands
+// in for a model without points3D.bin/.txt; without either, training starts from random points.
+PointCloud sfm_points(const ColmapModel& model, const ModelFiles& files) {
+  std::error_code ec;
+  if (fs::exists(files.points, ec)) return point_cloud_of(model.points);
+  const fs::path ply = files.points.parent_path() / "points3D.ply";
+  if (fs::exists(ply, ec)) return read_point_ply(ply);
+  spdlog::warn("{}: not found, nor points3D.ply beside it, so training starts from random points",
+               files.points.string());
+  return {};
+}
+
 fs::path model_dir(const fs::path& root) {
   std::error_code ec;
   const fs::path first = root / "sparse" / "0";
@@ -230,7 +247,7 @@ Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
     camera.split = i % options.test_every == 0 ? Split::Test : Split::Train;
     scene.cameras.push_back(std::move(camera));
   }
-  scene.points = point_cloud_of(model.points);
+  scene.points = sfm_points(model, files);
   return scene;
 }
 

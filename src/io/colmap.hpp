@@ -66,7 +66,7 @@ std::vector<ColmapPoint> parse_colmap_points(std::string_view bytes, ColmapEncod
                                              const std::filesystem::path& source);
 
 // Reads `dir`/{cameras,images,points3D}.bin, or the .txt files when there is no cameras.bin,
-// and checks that every image's camera exists.
+// and checks that every image's camera exists. A missing points3D file leaves no points.
 ColmapModel read_colmap_model(const std::filesystem::path& dir);
 // Write the three files atomically (COLMAP writes the text form with the same comment headers).
 void write_colmap_model_binary(const std::filesystem::path& dir, const ColmapModel& model);

@@ -1,16 +1,22 @@
 #include "io/scene.hpp"
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
+#include <set>
+#include <string_view>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/paths.hpp"
 #include "io/colmap.hpp"
 #include "io/transforms.hpp"
+#include "io/undistort.hpp"
 
 namespace iesrgs {
 
@@ -47,30 +53,57 @@ constexpr double kNarrowSpread = 0.01;
 
 enum class SceneFormat { None, Blender, Nerfstudio, NerfstudioFile, Colmap };
 
+constexpr const char* kTransformsFiles[] = {"transforms_train.json", "transforms_test.json",
+                                            "transforms.json"};
+
+bool has_blender_splits(const fs::path& folder) {
+  std::error_code ec;
+  return fs::exists(folder / kTransformsFiles[0], ec) ||
+         fs::exists(folder / kTransformsFiles[1], ec);
+}
+
+// In 3DGS's order: a folder with sparse/ is a COLMAP scene, whatever else it holds (instant-ngp's
+// colmap2nerf writes a transforms.json beside it, without the SfM points); then NeRF Synthetic's
+// split files; then nerfstudio's transforms.json.
 SceneFormat detect_format(const fs::path& root) {
   std::error_code ec;
   if (fs::is_regular_file(root, ec) && root.extension() == ".json")
     return SceneFormat::NerfstudioFile;
-  if (fs::exists(root / "transforms_train.json", ec) ||
-      fs::exists(root / "transforms_test.json", ec))
-    return SceneFormat::Blender;
-  if (fs::exists(root / "transforms.json", ec)) return SceneFormat::Nerfstudio;
   if (fs::is_directory(root / "sparse", ec)) return SceneFormat::Colmap;
+  if (has_blender_splits(root)) return SceneFormat::Blender;
+  if (fs::exists(root / "transforms.json", ec)) return SceneFormat::Nerfstudio;
   return SceneFormat::None;
 }
 
+// The transforms files a folder read as `format` holds but that format does not read.
+void warn_unread_transforms(const fs::path& root, SceneFormat format) {
+  std::vector<std::string> unread;
+  std::error_code ec;
+  for (const char* name : kTransformsFiles)
+    if (fs::exists(root / name, ec) &&
+        (format == SceneFormat::Colmap || std::string_view(name) == "transforms.json"))
+      unread.push_back(name);
+  if (unread.empty()) return;
+  spdlog::warn("{}: read as a {} scene; {} {} not read (give a .json file's path to read it)",
+               root.string(), format == SceneFormat::Colmap ? "COLMAP (sparse/)" : "NeRF Synthetic",
+               fmt::join(unread, ", "), unread.size() == 1 ? "is" : "are");
+}
+
 // A NeRF Synthetic split file read as a nerfstudio scene would take every 8th of its views for
-// test and the other split not at all.
+// test, its background black, and the other split not at all.
 void refuse_blender_split_file(const fs::path& file) {
   const std::string name = file.filename().string();
   if (name != "transforms_train.json" && name != "transforms_test.json" &&
       name != "transforms_val.json")
     return;
   const fs::path folder = file.parent_path();  // load_scene made the path absolute
-  if (detect_format(folder) == SceneFormat::Blender)
+  if (has_blender_splits(folder))
     fail_file(file, fmt::format("one split of a NeRF Synthetic scene: give the scene's folder, {}, "
                                 "which reads transforms_train.json and transforms_test.json",
                                 folder.string()));
+  fail_file(file,
+            "one split of a NeRF Synthetic scene, which is read from its folder's "
+            "transforms_train.json and transforms_test.json; this folder holds neither");
 }
 
 Scene read_any_format(const fs::path& root, const SceneOptions& options) {
@@ -79,10 +112,12 @@ Scene read_any_format(const fs::path& root, const SceneOptions& options) {
       refuse_blender_split_file(root);
       return read_nerfstudio_scene(root, options);
     case SceneFormat::Blender:
+      warn_unread_transforms(root, SceneFormat::Blender);
       return read_blender_scene(root, options);
     case SceneFormat::Nerfstudio:
       return read_nerfstudio_scene(root / "transforms.json", options);
     case SceneFormat::Colmap:
+      warn_unread_transforms(root, SceneFormat::Colmap);
       return read_colmap_scene(root, options);
     case SceneFormat::None:
       break;
@@ -90,8 +125,8 @@ Scene read_any_format(const fs::path& root, const SceneOptions& options) {
   std::error_code ec;
   if (!fs::is_directory(root, ec)) fail_file(root, "scene directory not found");
   fail_file(root,
-            "no scene found (looked for transforms_train.json, transforms_test.json, "
-            "transforms.json, sparse/0/)");
+            "no scene found (looked for sparse/0/, transforms_train.json, transforms_test.json, "
+            "transforms.json)");
 }
 
 void require_unique_names(const Scene& scene) {

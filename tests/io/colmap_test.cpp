@@ -372,6 +372,34 @@ TEST(Colmap, ModelDirectlyInSparseIsFound) {
   EXPECT_EQ(load_scene(root.path()).cameras.size(), 6u);
 }
 
+// As 3DGS reads it: a folder with sparse/ is a COLMAP scene, whatever transforms files lie beside
+// it (instant-ngp's colmap2nerf writes one, without the SfM points).
+TEST(Colmap, SparseComesBeforeAnyTransformsFile) {
+  TempDir root;
+  write_sample_scene(root.path());
+  for (const char* name : {"transforms.json", "transforms_train.json"})
+    write_text(root / name, "{}");  // read, either would fail
+  const Scene scene = load_scene(root.path());
+  EXPECT_EQ(scene.format, "colmap");
+  EXPECT_EQ(scene.points.positions.size(), sample_model().points.size());
+}
+
+// 3DGS's own points3D.ply stands in for points3D.bin; without either, the start is random.
+TEST(Colmap, PointsComeFromPoints3DPlyOrTrainingStartsFromRandomPoints) {
+  TempDir root;
+  write_sample_scene(root.path());
+  fs::remove(root / "sparse" / "0" / "points3D.bin");
+  EXPECT_TRUE(load_scene(root.path()).points.positions.empty());
+  write_text(root / "sparse" / "0" / "points3D.ply",
+             "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+             "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+             "end_header\n1 2 3 255 0 0\n");
+  const Scene scene = load_scene(root.path());
+  ASSERT_EQ(scene.points.positions.size(), 1u);
+  EXPECT_DOUBLE_EQ(scene.points.positions[0].z, 3);
+  EXPECT_EQ(scene.points.colors[0][0], 255);
+}
+
 TEST(Colmap, TruncatedBinaryFilesNameTheFile) {
   TempDir dir;
   write_colmap_model_binary(dir.path(), tiny_model());
@@ -546,9 +574,9 @@ TEST(Colmap, MissingFilesAreNamed) {
   expect_error([&] { load_scene(root.path()); },
                {(root / "sparse/0").string(), "neither cameras.bin nor cameras.txt"});
   write_colmap_model_binary(root / "sparse/0", sample_model());
-  fs::remove(root / "sparse/0/points3D.bin");
+  fs::remove(root / "sparse/0/images.bin");
   expect_error([&] { load_scene(root.path()); },
-               {(root / "sparse/0/points3D.bin").string(), "file not found"});
+               {(root / "sparse/0/images.bin").string(), "file not found"});
 }
 
 TEST(Colmap, WritersRefuseWhatCannotBeReadBack) {

@@ -77,6 +77,22 @@ TEST(Scene, ASplitFileOfANerfSyntheticSceneNamesItsFolder) {
   }
 }
 
+// Alone in a folder, a split file is still not a nerfstudio scene.
+TEST(Scene, ASplitFileWithoutItsSceneIsRefused) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 3, 1});
+  std::filesystem::create_directories(dir / "alone");
+  std::filesystem::copy_file(dir / "scene" / "transforms_test.json",
+                             dir / "alone" / "transforms_val.json");
+  const std::string message =
+      error_message([&] { load_scene(dir / "alone" / "transforms_val.json"); });
+  EXPECT_TRUE(contains(message,
+                       "transforms_val.json: one split of a NeRF Synthetic scene, which "
+                       "is read from its folder's transforms_train.json and "
+                       "transforms_test.json; this folder holds neither"))
+      << message;
+}
+
 // Renders into the scene's folder would replace a nerfstudio scene's rgb/ images, a trained
 // model its SfM points.
 TEST(Scene, OutputsGoAnywhereButTheScenesOwnFolder) {
