@@ -161,6 +161,39 @@ void require_pinhole_view(const Camera& camera) {
                         k.fx, k.fy, k.cx, k.cy, k.width, k.height, kWidestFieldOfView));
 }
 
+// Undistortion keeps each camera's intrinsics and size (io/undistort.hpp): where the lens's image
+// does not reach the frame's edge, the border's pixels repeat, and training takes them as seen.
+// Said once per lens and process (`run` loads its scene twice), naming its first image.
+void warn_repeated_borders(const Scene& scene) {
+  static std::set<std::array<double, 14>> lenses;
+  for (const Camera& camera : scene.cameras) {
+    const Intrinsics& k = camera.stored;
+    const Distortion& d = camera.distortion;
+    const std::array<double, 14> lens{double(k.width),
+                                      double(k.height),
+                                      k.fx,
+                                      k.fy,
+                                      k.cx,
+                                      k.cy,
+                                      d.k1,
+                                      d.k2,
+                                      d.p1,
+                                      d.p2,
+                                      d.k3,
+                                      d.k4,
+                                      d.k5,
+                                      d.k6};
+    if (!d.any() || !lenses.insert(lens).second) continue;
+    if (const double share = share_sampled_outside(k, d); share > 0)
+      spdlog::warn(
+          "{}: once undistorted, {:.1f}% of its pixels (and of the other views' with its "
+          "camera) lie beyond what the lens saw and repeat the image's border, which training "
+          "takes as seen; undistorting and cropping the images beforehand (COLMAP's "
+          "image_undistorter) avoids it",
+          camera.image_path.string(), 100 * share);
+  }
+}
+
 }  // namespace
 
 bool is_scene(const fs::path& path) {
@@ -250,6 +283,7 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
                             "smaller downscale or scale factor",
                             options.downscale, camera.stored.width, camera.stored.height));
   }
+  warn_repeated_borders(scene);
   return scene;
 }
 

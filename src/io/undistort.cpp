@@ -23,18 +23,39 @@ void sample_bilinear(const Image8& image, double x, double y, uint8_t* out) {
   }
 }
 
+// Where the pinhole pixel (u, v), centers at +0.5, lies in the distorted image.
+void source_point(const Intrinsics& k, const Distortion& distortion, int u, int v, double& x,
+                  double& y) {
+  double xd, yd;
+  distortion.apply((u + 0.5 - k.cx) / k.fx, (v + 0.5 - k.cy) / k.fy, xd, yd);
+  x = xd * k.fx + k.cx;
+  y = yd * k.fy + k.cy;
+}
+
 }  // namespace
+
+double share_sampled_outside(const Intrinsics& intrinsics, const Distortion& distortion) {
+  constexpr int kStride = 4;  // pixels: the bands beyond the lens's image are wider
+  int64_t outside = 0, all = 0;
+  for (int v = 0; v < intrinsics.height; v += kStride)
+    for (int u = 0; u < intrinsics.width; u += kStride) {
+      double x, y;
+      source_point(intrinsics, distortion, u, v, x, y);
+      outside += !(x >= 0 && x <= intrinsics.width && y >= 0 && y <= intrinsics.height);
+      ++all;
+    }
+  return all ? double(outside) / double(all) : 0;
+}
 
 Image8 undistort_image(const Image8& image, const Intrinsics& intrinsics,
                        const Distortion& distortion) {
-  const Intrinsics& k = intrinsics;
   Image8 out(image.width, image.height, image.channels);
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < image.height; ++v)
     for (int u = 0; u < image.width; ++u) {
-      double xd, yd;
-      distortion.apply((u + 0.5 - k.cx) / k.fx, (v + 0.5 - k.cy) / k.fy, xd, yd);
-      sample_bilinear(image, xd * k.fx + k.cx, yd * k.fy + k.cy, &out.at(u, v, 0));
+      double x, y;
+      source_point(intrinsics, distortion, u, v, x, y);
+      sample_bilinear(image, x, y, &out.at(u, v, 0));
     }
   return out;
 }

@@ -112,5 +112,17 @@ TEST(Undistort, SamplesOutsideTheImageClampToTheBorder) {
   }
 }
 
+// Pincushion pushes the frame's edges beyond the lens's image; barrel pulls the image's edges in.
+TEST(Undistort, TheShareSampledOutsideIsWhereTheBorderRepeats) {
+  const Intrinsics k{400, 300, 200, 200, 200, 150};
+  EXPECT_EQ(share_sampled_outside(k, {}), 0);
+  EXPECT_EQ(share_sampled_outside(k, {-0.05, 0, 0, 0}), 0);
+  // At the middle of the frame's side (x = 1), the ray lands 1 + k1 = 1.1 out: 20 px beyond.
+  const double pincushion = share_sampled_outside(k, {0.1, 0, 0, 0});
+  EXPECT_GT(pincushion, 0.02);
+  EXPECT_LT(pincushion, 0.2);
+  EXPECT_GT(share_sampled_outside(k, {0.5, 0, 0, 0}), pincushion);
+}
+
 }  // namespace
 }  // namespace iesrgs
