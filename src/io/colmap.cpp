@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/colmap_codec.hpp"
+#include "io/image.hpp"
 #include "io/ply.hpp"
 
 namespace iesrgs {
@@ -164,6 +166,26 @@ Lens lens_of(const ColmapCamera& camera, const fs::path& cameras_file) {
   return lens;
 }
 
+// As gsplat reads a model whose images were resized after COLMAP ran: a camera whose first image
+// is its size times one factor, to the rounding, takes that image's size and its intrinsics
+// scaled to it. Any other size is refused when the image is decoded.
+void fit_lens_to_images(uint32_t id, Lens& lens, const fs::path& first_image,
+                        const fs::path& cameras_file) {
+  std::error_code ec;
+  if (!fs::is_regular_file(first_image, ec)) return;  // reported when it is decoded
+  const ImageHeader header = read_image_header(first_image);
+  const Intrinsics& k = lens.intrinsics;
+  if (header.width == k.width && header.height == k.height) return;
+  const Intrinsics fitted = k.scaled(double(header.width) / k.width);
+  if (fitted.width != header.width || fitted.height != header.height) return;
+  spdlog::warn(
+      "{}: camera {} is {}x{}, its images {}x{} ({} first): its intrinsics are scaled to "
+      "them",
+      cameras_file.string(), id, k.width, k.height, header.width, header.height,
+      first_image.string());
+  lens.intrinsics = fitted;
+}
+
 Camera camera_of(const ColmapImage& image, const Lens& lens, const fs::path& root,
                  const fs::path& images_file) {
   const double norm = std::sqrt(image.qw * image.qw + image.qx * image.qx + image.qy * image.qy +
@@ -237,6 +259,11 @@ Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
     if (images[i]->name == images[i - 1]->name)
       fail_file(files.images, fmt::format("image '{}' is listed twice (ids {} and {})",
                                           images[i]->name, images[i - 1]->id, images[i]->id));
+  std::set<uint32_t> fitted;
+  for (const ColmapImage* image : images)
+    if (fitted.insert(image->camera_id).second)
+      fit_lens_to_images(image->camera_id, lenses.at(image->camera_id),
+                         root / "images" / image->name, files.cameras);
 
   Scene scene;
   scene.root = root;

@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/colmap.hpp"
+#include "io/image.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -398,6 +399,24 @@ TEST(Colmap, PointsComeFromPoints3DPlyOrTrainingStartsFromRandomPoints) {
   ASSERT_EQ(scene.points.positions.size(), 1u);
   EXPECT_DOUBLE_EQ(scene.points.positions[0].z, 3);
   EXPECT_EQ(scene.points.colors[0][0], 255);
+}
+
+// As gsplat reads a model whose images were resized after COLMAP ran.
+TEST(Colmap, ACameraTakesTheSizeOfItsImagesWhenTheyAreItsSizeScaled) {
+  TempDir root;
+  write_sample_scene(root.path());
+  fs::create_directories(root / "images");
+  write_png(root / "images" / "frame_a.jpg", Image8(400, 300, 3));  // camera 2, 800x600
+  const Scene scene = load_scene(root.path());
+  const Intrinsics& half = camera_named(scene, "frame_a").stored;
+  EXPECT_EQ(half.width, 400);
+  EXPECT_EQ(half.height, 300);
+  EXPECT_DOUBLE_EQ(half.fx, 700.25 / 2);
+  EXPECT_DOUBLE_EQ(half.cy, 299.5 / 2);
+  // Another shape is no resize: refused when the image is decoded.
+  write_png(root / "images" / "frame_a.jpg", Image8(400, 200, 3));
+  const Scene unfitted = load_scene(root.path());
+  EXPECT_EQ(camera_named(unfitted, "frame_a").stored.height, 600);
 }
 
 TEST(Colmap, TruncatedBinaryFilesNameTheFile) {
