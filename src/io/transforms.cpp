@@ -406,6 +406,27 @@ std::vector<Camera> parse_blender_transforms(const std::string& text, const fs::
   return cameras;
 }
 
+fs::path common_folder(const fs::path& a, const fs::path& b) {
+  fs::path common;
+  for (auto i = a.begin(), j = b.begin(); i != a.end() && j != b.end() && *i == *j; ++i, ++j)
+    common /= *i;
+  return common;
+}
+
+// Views are named after their image's path below the folder all images share, '/' as '_', as
+// COLMAP's are below images/: a rig's cam0/0000.jpg and cam1/0000.jpg are cam0_0000 and
+// cam1_0000, and images of one folder keep their stem.
+void name_below_common_folder(std::vector<std::pair<std::string, Camera>>& cameras) {
+  if (cameras.empty()) return;
+  fs::path common = cameras.front().second.image_path.parent_path();
+  for (const auto& [file_path, camera] : cameras)
+    common = common_folder(common, camera.image_path.parent_path());
+  for (auto& [file_path, camera] : cameras) {
+    camera.name = camera.image_path.lexically_relative(common).replace_extension().generic_string();
+    std::replace(camera.name.begin(), camera.name.end(), '/', '_');
+  }
+}
+
 Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_path,
                                   const SceneOptions& options, const ImageHeaderReader& read_header,
                                   const PointFileReader& read_points) {
@@ -416,6 +437,7 @@ Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_
   // The split must not depend on the order frames happen to be listed in.
   std::stable_sort(cameras.begin(), cameras.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  name_below_common_folder(cameras);
   Scene scene;
   scene.format = "nerfstudio";
   scene.synthetic = false;

@@ -353,6 +353,18 @@ TEST(NerfstudioScene, CameraModels) {
   }
 }
 
+// A rig's folders keep the same file names: the folder below the one all images share stays in
+// the name, as COLMAP scenes name their views.
+TEST(NerfstudioScene, ViewsAreNamedAfterTheirPathBelowTheFolderAllImagesShare) {
+  json document = nerfstudio_document();
+  EXPECT_EQ(parse_in_memory(document).cameras[0].name, "a");
+  document["frames"] = {frame("images/cam1/0001.jpg"), frame("images/cam0/0001.jpg"),
+                        frame("images/cam0/sub/0002.jpg")};
+  std::vector<std::string> names;
+  for (const Camera& camera : parse_in_memory(document).cameras) names.push_back(camera.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"cam0_0001", "cam0_sub_0002", "cam1_0001"}));
+}
+
 TEST(NerfstudioScene, MissingImageIsAnError) {
   TempDir dir;
   const fs::path json_path = write_nerfstudio_scene(dir, nerfstudio_document());
