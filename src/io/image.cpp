@@ -3,7 +3,6 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -46,16 +45,31 @@ void require_readable(const fs::path& path) {
 constexpr double kMostPixelsPerByte = 16384;
 constexpr double kAnySmallImage = 1 << 20;  // pixels: headers and tables weigh in small files
 
-std::string decode_problem() {
-  const int open_error = errno;  // what stb's fopen left, before anything here changes it
+constexpr std::string_view kPngSignature = "\x89PNG\r\n\x1a\n";
+
+// Why `bytes` cannot be read, as a PNG or a JPEG by their signature: stb tries each decoder in
+// turn, so its own reason may be another format's.
+std::string unreadable(std::string_view bytes, std::string_view reason) {
+  if (bytes.substr(0, kPngSignature.size()) == kPngSignature)
+    return fmt::format("not a readable PNG ({})", reason);
+  if (bytes.substr(0, 3) == "\xff\xd8\xff") return fmt::format("not a readable JPEG ({})", reason);
+  return bytes.empty() ? "empty file, not an image"
+                       : "not a PNG or JPEG file (it begins with neither's signature)";
+}
+
+std::string decode_problem(std::string_view bytes) {
   const char* reason = stbi_failure_reason();
-  if (reason && std::string_view(reason) == "can't fopen")
-    return std::string("cannot be opened: ") + std::strerror(open_error);
   if (reason && std::string_view(reason) == "too large")  // or damaged: a header's size is read
     return "too large to decode: more than 16777216 pixels a side or 2 GiB of pixels, or its "
            "header is damaged";
-  return std::string("not a readable PNG/JPEG (") +
-         (reason && *reason ? reason : "damaged or truncated") + ")";
+  return unreadable(bytes, reason && *reason ? reason : "damaged or truncated");
+}
+
+// stb takes the length as an int.
+const stbi_uc* stb_bytes(std::string_view bytes, const fs::path& path) {
+  if (bytes.size() > size_t(std::numeric_limits<int>::max()))
+    fail_file(path, unreadable(bytes, "over 2 GiB"));
+  return reinterpret_cast<const stbi_uc*>(bytes.data());
 }
 
 uint32_t big_endian32(std::string_view bytes, size_t at) {
@@ -69,14 +83,13 @@ uint32_t big_endian32(std::string_view bytes, size_t at) {
 // other ancillary chunks, which stb skips, are not checked. A chunk reaching past the end of the
 // file is refused too: stb would first allocate the length it claims, up to 4 GB.
 void check_png_crcs(std::string_view bytes, const fs::path& path) {
-  constexpr std::string_view kSignature = "\x89PNG\r\n\x1a\n";
-  if (bytes.substr(0, kSignature.size()) != kSignature) return;
-  for (size_t at = kSignature.size(); at + 12 <= bytes.size();) {
+  if (bytes.substr(0, kPngSignature.size()) != kPngSignature) return;
+  for (size_t at = kPngSignature.size(); at + 12 <= bytes.size();) {
     const uint64_t length = big_endian32(bytes, at);
     if (at + 12 + length > bytes.size())
-      fail_file(path, fmt::format("not a readable PNG/JPEG (truncated: its chunk {} at byte {} "
-                                  "claims {} bytes, past the end of the file)",
-                                  bytes.substr(at + 4, 4), at, length));
+      fail_file(path, unreadable(bytes, fmt::format("truncated: its chunk {} at byte {} claims "
+                                                    "{} bytes, past the end of the file",
+                                                    bytes.substr(at + 4, 4), at, length)));
     const std::string_view typed = bytes.substr(at + 4, 4 + length);  // the type and the data
     const std::string_view type = typed.substr(0, 4);
     const bool needed = (type[0] & 0x20) == 0 || type == "tRNS";
@@ -167,9 +180,13 @@ std::optional<std::pair<fs::path, fs::path>> first_shared_stem(const std::vector
 
 ImageHeader read_image_header(const fs::path& path) {
   require_readable(path);
+  const MappedFile file(path);  // only the pages of the header are read
+  const std::string_view bytes = file.bytes();
   ImageHeader header;
-  if (!stbi_info(path.c_str(), &header.width, &header.height, &header.channels))
-    fail_file(path, decode_problem());
+  int channels = 0;
+  if (!stbi_info_from_memory(stb_bytes(bytes, path), int(bytes.size()), &header.width,
+                             &header.height, &channels))
+    fail_file(path, decode_problem(bytes));
   return header;
 }
 
@@ -178,10 +195,8 @@ Image8 read_image8(const fs::path& path) {
   const MappedFile file(path);
   const std::string_view bytes = file.bytes();
   check_png_crcs(bytes, path);
-  if (bytes.size() > size_t(std::numeric_limits<int>::max()))
-    fail_file(path, "not a readable PNG/JPEG (over 2 GiB)");
   int w = 0, h = 0, c = 0;
-  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
+  const stbi_uc* data = stb_bytes(bytes, path);
   // A header can claim any size; deflate and JPEG's entropy coding cannot pack more than some
   // thousand pixels into a byte (8256 for a 1-bit PNG of one colour), so a claim far beyond that
   // is damage, refused before stb allocates for it.
@@ -192,7 +207,7 @@ Image8 read_image8(const fs::path& path) {
                                 w, h, bytes.size()));
   std::unique_ptr<stbi_uc, void (*)(void*)> pixels(
       stbi_load_from_memory(data, int(bytes.size()), &w, &h, &c, 0), stbi_image_free);
-  if (!pixels) fail_file(path, decode_problem());
+  if (!pixels) fail_file(path, decode_problem(bytes));
   Image8 image(w, h, c);
   std::memcpy(image.data.data(), pixels.get(), image.data.size());
   return image;

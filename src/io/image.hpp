@@ -25,7 +25,7 @@ using Image = ImageOf<float>;     // values in [0, 1] for color
 using Image8 = ImageOf<uint8_t>;  // as stored in files
 
 struct ImageHeader {
-  int width = 0, height = 0, channels = 0;
+  int width = 0, height = 0;
 };
 
 // The PNG and JPEG files directly inside `folder`, in name order; throws Error naming the folder

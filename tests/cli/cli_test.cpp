@@ -184,8 +184,8 @@ TEST(Cli, UpscaleWritesOnePngPerImageOfAFolder) {
                             (dir / "out").string());
   EXPECT_EQ(run.status, 0) << run.output;
   EXPECT_TRUE(contains(run.output, "[2/2]")) << run.output;
-  const ImageHeader a = read_image_header(dir / "out" / "a.png");
-  const ImageHeader b = read_image_header(dir / "out" / "b.png");
+  const Image8 a = read_image8(dir / "out" / "a.png");
+  const Image8 b = read_image8(dir / "out" / "b.png");
   EXPECT_EQ(std::make_tuple(a.width, a.height, a.channels), std::make_tuple(20, 16, 3));
   EXPECT_EQ(std::make_tuple(b.width, b.height, b.channels), std::make_tuple(12, 10, 3));
 }

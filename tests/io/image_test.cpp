@@ -127,10 +127,21 @@ TEST(Image, CorruptFilesAreNamed) {
   // image format read here, so no file of another kind decodes as one.
   write_text(dir / "tga.png",
              std::string("\0\0\x0a\0\0\0\0\0\0\0\0\0\xb0\xb3\xb0\xb3\x18\0\0\0", 20));
-  for (const char* name : {"truncated.png", "garbage.jpg", "empty.png", "tga.png"}) {
-    const std::string message = error_message([&] { read_image8(dir / name); });
-    EXPECT_NE(message.find(std::string(name) + ": not a readable PNG/JPEG"), std::string::npos)
-        << message;
+  EXPECT_NE(error_message([&] {
+              read_image8(dir / "truncated.png");
+            }).find("truncated.png: not a readable PNG (truncated: its chunk IDAT"),
+            std::string::npos);
+  // A file is named as the kind its signature says, whichever decoder stb tried last.
+  write_text(dir / "cut.jpg", std::string("\xff\xd8\xff\xe0\0\x10JFIF", 10));
+  const std::pair<const char*, const char*> cases[] = {
+      {"cut.jpg", "not a readable JPEG ("},
+      {"garbage.jpg", "not a PNG or JPEG file (it begins with neither's signature)"},
+      {"empty.png", "empty file, not an image"},
+      {"tga.png", "not a PNG or JPEG file"}};
+  for (const auto& [name, problem] : cases) {
+    for (const std::string& message : {error_message([&] { read_image8(dir / name); }),
+                                       error_message([&] { read_image_header(dir / name); })})
+      EXPECT_NE(message.find(std::string(name) + ": " + problem), std::string::npos) << message;
   }
 }
 
@@ -149,7 +160,7 @@ TEST(Image, APngWhoseDataFailsItsCrcIsDamaged) {
   write_text(dir / "no_end.png", read_file(dir / "ok.png").substr(0, end - 4));
   // stb wants the end chunk, and says nothing of why: the message does.
   EXPECT_EQ(error_message([&] { read_image8(dir / "no_end.png"); }),
-            (dir / "no_end.png").string() + ": not a readable PNG/JPEG (damaged or truncated)");
+            (dir / "no_end.png").string() + ": not a readable PNG (damaged or truncated)");
   // A header claiming 2^25 pixels a side: stb's bare "too large" is explained.
   write_text(dir / "huge.png", with_size(read_file(dir / "ok.png"), 1 << 25, 64));
   EXPECT_NE(error_message([&] {
@@ -169,8 +180,8 @@ TEST(Image, APngWhoseDataFailsItsCrcIsDamaged) {
   write_text(dir / "long_chunk.png", long_chunk);
   EXPECT_EQ(error_message([&] { read_image8(dir / "long_chunk.png"); }),
             (dir / "long_chunk.png").string() +
-                ": not a readable PNG/JPEG (truncated: its chunk IDAT at byte " +
-                std::to_string(idat) + " claims 1145652289 bytes, past the end of the file)");
+                ": not a readable PNG (truncated: its chunk IDAT at byte " + std::to_string(idat) +
+                " claims 1145652289 bytes, past the end of the file)");
   // A text chunk, which stb skips, with a wrong CRC: libpng warns and reads the image, as here.
   std::string text = read_file(dir / "ok.png");
   text.insert(33, std::string("\0\0\0\5tEXta\0bcd\0\0\0\0", 17));  // after IHDR

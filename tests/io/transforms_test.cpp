@@ -56,7 +56,7 @@ Scene parse_in_memory(const json& document, const SceneOptions& options = {}) {
   return parse_nerfstudio_transforms(
       document.dump(), "/data/transforms.json", options,
       [](const fs::path&) {
-        return ImageHeader{64, 48, 3};
+        return ImageHeader{64, 48};
       },
       [](const fs::path& path) {
         PointCloud points;  // one point, whose colour says which file was asked for
