@@ -1,12 +1,13 @@
 #include "io/colmap.hpp"
 
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "core/error.hpp"
+#include "core/log_once.hpp"
 #include "io/atomic_file.hpp"
 #include "io/colmap_codec.hpp"
 #include "io/image.hpp"
@@ -167,23 +168,25 @@ Lens lens_of(const ColmapCamera& camera, const fs::path& cameras_file) {
 }
 
 // As gsplat reads a model whose images were resized after COLMAP ran: a camera whose first image
-// is its size times one factor, to the rounding, takes that image's size and its intrinsics
-// scaled to it. Any other size is refused when the image is decoded.
-void fit_lens_to_images(uint32_t id, Lens& lens, const fs::path& first_image,
-                        const fs::path& cameras_file) {
+// is its size scaled, each side to within a pixel of the other's factor, takes that image's size
+// and its intrinsics scaled to it. Returns whether it did. Any other size, and an image that
+// cannot be read, are refused when the image is decoded.
+bool fit_lens_to_image(Lens& lens, const fs::path& first_image) {
   std::error_code ec;
-  if (!fs::is_regular_file(first_image, ec)) return;  // reported when it is decoded
-  const ImageHeader header = read_image_header(first_image);
+  if (!fs::is_regular_file(first_image, ec)) return false;
+  ImageHeader header;
+  try {
+    header = read_image_header(first_image);
+  } catch (const Error&) {
+    return false;
+  }
   const Intrinsics& k = lens.intrinsics;
-  if (header.width == k.width && header.height == k.height) return;
-  const Intrinsics fitted = k.scaled(double(header.width) / k.width);
-  if (fitted.width != header.width || fitted.height != header.height) return;
-  spdlog::warn(
-      "{}: camera {} is {}x{}, its images {}x{} ({} first): its intrinsics are scaled to "
-      "them",
-      cameras_file.string(), id, k.width, k.height, header.width, header.height,
-      first_image.string());
-  lens.intrinsics = fitted;
+  if (header.width == k.width && header.height == k.height) return false;
+  const double sx = double(header.width) / k.width, sy = double(header.height) / k.height;
+  if (std::abs(k.height * sx - header.height) >= 1 || std::abs(k.width * sy - header.width) >= 1)
+    return false;
+  lens.intrinsics = {header.width, header.height, k.fx * sx, k.fy * sy, k.cx * sx, k.cy * sy};
+  return true;
 }
 
 Camera camera_of(const ColmapImage& image, const Lens& lens, const fs::path& root,
@@ -224,8 +227,10 @@ PointCloud sfm_points(const ColmapModel& model, const ModelFiles& files) {
   if (fs::exists(files.points, ec)) return point_cloud_of(model.points);
   const fs::path ply = files.points.parent_path() / "points3D.ply";
   if (fs::exists(ply, ec)) return read_point_ply(ply);
-  spdlog::warn("{}: not found, nor points3D.ply beside it, so training starts from random points",
-               files.points.string());
+  warn_once(
+      fmt::format("{}: not found, nor points3D.ply beside it, so training starts from "
+                  "random points",
+                  files.points.string()));
   return {};
 }
 
@@ -259,11 +264,22 @@ Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
     if (images[i]->name == images[i - 1]->name)
       fail_file(files.images, fmt::format("image '{}' is listed twice (ids {} and {})",
                                           images[i]->name, images[i - 1]->id, images[i]->id));
-  std::set<uint32_t> fitted;
-  for (const ColmapImage* image : images)
-    if (fitted.insert(image->camera_id).second)
-      fit_lens_to_images(image->camera_id, lenses.at(image->camera_id),
-                         root / "images" / image->name, files.cameras);
+  std::set<uint32_t> seen;
+  std::vector<std::string> fitted;  // what each fit was, for the warning
+  for (const ColmapImage* image : images) {
+    if (!seen.insert(image->camera_id).second) continue;
+    Lens& lens = lenses.at(image->camera_id);
+    const Intrinsics before = lens.intrinsics;
+    if (fit_lens_to_image(lens, root / "images" / image->name))
+      fitted.push_back(fmt::format("camera {}, {}x{}, whose {} is {}x{}", image->camera_id,
+                                   before.width, before.height, image->name, lens.intrinsics.width,
+                                   lens.intrinsics.height));
+  }
+  if (!fitted.empty())
+    warn_once(
+        fmt::format("{}: {} of its cameras are not the size of their images but that size "
+                    "scaled; their intrinsics are scaled to the images (first: {})",
+                    files.cameras.string(), fitted.size(), fitted.front()));
 
   Scene scene;
   scene.root = root;

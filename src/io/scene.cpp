@@ -1,18 +1,15 @@
 #include "io/scene.hpp"
 
 #include <fmt/core.h>
-#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
-#include <set>
-#include <string_view>
-#include <vector>
 
 #include "core/error.hpp"
+#include "core/log_once.hpp"
 #include "core/paths.hpp"
 #include "io/colmap.hpp"
 #include "io/transforms.hpp"
@@ -53,13 +50,15 @@ constexpr double kNarrowSpread = 0.01;
 
 enum class SceneFormat { None, Blender, Nerfstudio, NerfstudioFile, Colmap };
 
-constexpr const char* kTransformsFiles[] = {"transforms_train.json", "transforms_test.json",
-                                            "transforms.json"};
-
 bool has_blender_splits(const fs::path& folder) {
   std::error_code ec;
-  return fs::exists(folder / kTransformsFiles[0], ec) ||
-         fs::exists(folder / kTransformsFiles[1], ec);
+  return fs::exists(folder / "transforms_train.json", ec) ||
+         fs::exists(folder / "transforms_test.json", ec);
+}
+
+bool has_sparse(const fs::path& folder) {
+  std::error_code ec;
+  return fs::is_directory(folder / "sparse", ec);
 }
 
 // In 3DGS's order: a folder with sparse/ is a COLMAP scene, whatever else it holds (instant-ngp's
@@ -69,24 +68,29 @@ SceneFormat detect_format(const fs::path& root) {
   std::error_code ec;
   if (fs::is_regular_file(root, ec) && root.extension() == ".json")
     return SceneFormat::NerfstudioFile;
-  if (fs::is_directory(root / "sparse", ec)) return SceneFormat::Colmap;
+  if (has_sparse(root)) return SceneFormat::Colmap;
   if (has_blender_splits(root)) return SceneFormat::Blender;
   if (fs::exists(root / "transforms.json", ec)) return SceneFormat::Nerfstudio;
   return SceneFormat::None;
 }
 
-// The transforms files a folder read as `format` holds but that format does not read.
+// The transforms files a folder read as `format` holds but that format does not read, and how to
+// read them.
 void warn_unread_transforms(const fs::path& root, SceneFormat format) {
-  std::vector<std::string> unread;
   std::error_code ec;
-  for (const char* name : kTransformsFiles)
-    if (fs::exists(root / name, ec) &&
-        (format == SceneFormat::Colmap || std::string_view(name) == "transforms.json"))
-      unread.push_back(name);
-  if (unread.empty()) return;
-  spdlog::warn("{}: read as a {} scene; {} {} not read (give a .json file's path to read it)",
-               root.string(), format == SceneFormat::Colmap ? "COLMAP (sparse/)" : "NeRF Synthetic",
-               fmt::join(unread, ", "), unread.size() == 1 ? "is" : "are");
+  const bool nerfstudio = fs::exists(root / "transforms.json", ec);
+  const bool splits = format == SceneFormat::Colmap && has_blender_splits(root);
+  if (!nerfstudio && !splits) return;
+  std::string message =
+      fmt::format("{}: read as a {} scene", root.string(),
+                  format == SceneFormat::Colmap ? "COLMAP (it holds sparse/)" : "NeRF Synthetic");
+  if (nerfstudio)
+    message += "; its transforms.json is not read (give that file's path to read it instead)";
+  if (splits)
+    message +=
+        "; its NeRF Synthetic split files are not read (they are read from a folder "
+        "without sparse/)";
+  warn_once(message);
 }
 
 // A NeRF Synthetic split file read as a nerfstudio scene would take every 8th of its views for
@@ -97,13 +101,18 @@ void refuse_blender_split_file(const fs::path& file) {
       name != "transforms_val.json")
     return;
   const fs::path folder = file.parent_path();  // load_scene made the path absolute
-  if (has_blender_splits(folder))
-    fail_file(file, fmt::format("one split of a NeRF Synthetic scene: give the scene's folder, {}, "
-                                "which reads transforms_train.json and transforms_test.json",
+  if (!has_blender_splits(folder))
+    fail_file(file,
+              "one split of a NeRF Synthetic scene, which is read from its folder's "
+              "transforms_train.json and transforms_test.json; this folder holds neither");
+  if (has_sparse(folder))
+    fail_file(file, fmt::format("one split of a NeRF Synthetic scene, read from its folder; but "
+                                "{} holds sparse/ and is read as a COLMAP scene: move the NeRF "
+                                "Synthetic files to a folder of their own",
                                 folder.string()));
-  fail_file(file,
-            "one split of a NeRF Synthetic scene, which is read from its folder's "
-            "transforms_train.json and transforms_test.json; this folder holds neither");
+  fail_file(file, fmt::format("one split of a NeRF Synthetic scene: give the scene's folder, {}, "
+                              "which reads transforms_train.json and transforms_test.json",
+                              folder.string()));
 }
 
 Scene read_any_format(const fs::path& root, const SceneOptions& options) {
@@ -163,12 +172,15 @@ void require_pinhole_view(const Camera& camera) {
 
 // Undistortion keeps each camera's intrinsics and size (io/undistort.hpp): where the lens's image
 // does not reach the frame's edge, the border's pixels repeat, and training takes them as seen.
-// Said once per lens and process (`run` loads its scene twice), naming its first image.
 void warn_repeated_borders(const Scene& scene) {
-  static std::set<std::array<double, 14>> lenses;
+  std::map<std::array<double, 14>, double> share_of_lens;
+  size_t views = 0;
+  double largest = 0;
+  const Camera* widest = nullptr;
   for (const Camera& camera : scene.cameras) {
     const Intrinsics& k = camera.stored;
     const Distortion& d = camera.distortion;
+    if (!d.any()) continue;
     const std::array<double, 14> lens{double(k.width),
                                       double(k.height),
                                       k.fx,
@@ -183,15 +195,22 @@ void warn_repeated_borders(const Scene& scene) {
                                       d.k4,
                                       d.k5,
                                       d.k6};
-    if (!d.any() || !lenses.insert(lens).second) continue;
-    if (const double share = share_sampled_outside(k, d); share > 0)
-      spdlog::warn(
-          "{}: once undistorted, {:.1f}% of its pixels (and of the other views' with its "
-          "camera) lie beyond what the lens saw and repeat the image's border, which training "
-          "takes as seen; undistorting and cropping the images beforehand (COLMAP's "
-          "image_undistorter) avoids it",
-          camera.image_path.string(), 100 * share);
+    const auto [it, added] = share_of_lens.emplace(lens, 0.0);
+    if (added) it->second = share_sampled_outside(k, d);
+    if (it->second == 0) continue;
+    ++views;
+    if (it->second > largest) {
+      largest = it->second;
+      widest = &camera;
+    }
   }
+  if (!widest) return;
+  warn_once(fmt::format(
+      "{} of the scene's {} views, once undistorted, have pixels beyond what their lens saw, up "
+      "to {:.1f}% of a view ({}), where the image's border repeats and training takes it as "
+      "seen; undistorting and cropping the images beforehand (COLMAP's image_undistorter) "
+      "avoids it",
+      views, scene.cameras.size(), 100 * largest, widest->image_path.string()));
 }
 
 }  // namespace

@@ -1,6 +1,5 @@
 #include "io/transforms.hpp"
 
-#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -12,6 +11,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/log_once.hpp"
 #include "core/paths.hpp"
 #include "io/atomic_file.hpp"
 #include "io/json_file.hpp"
@@ -487,7 +487,7 @@ Scene read_blender_scene(const fs::path& root, const SceneOptions&) {
 PointCloud read_point_ply_if_present(const fs::path& path) {
   std::error_code ec;
   if (fs::exists(path, ec)) return read_point_ply(path);
-  spdlog::warn("{}: not found, so training starts from random points", path.string());
+  warn_once(fmt::format("{}: not found, so training starts from random points", path.string()));
   return {};
 }
 

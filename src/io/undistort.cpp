@@ -23,11 +23,11 @@ void sample_bilinear(const Image8& image, double x, double y, uint8_t* out) {
   }
 }
 
-// Where the pinhole pixel (u, v), centers at +0.5, lies in the distorted image.
-void source_point(const Intrinsics& k, const Distortion& distortion, int u, int v, double& x,
+// Where the pinhole image's point (u, v) lies in the distorted image (image corner at 0).
+void source_point(const Intrinsics& k, const Distortion& distortion, double u, double v, double& x,
                   double& y) {
   double xd, yd;
-  distortion.apply((u + 0.5 - k.cx) / k.fx, (v + 0.5 - k.cy) / k.fy, xd, yd);
+  distortion.apply((u - k.cx) / k.fx, (v - k.cy) / k.fy, xd, yd);
   x = xd * k.fx + k.cx;
   y = yd * k.fy + k.cy;
 }
@@ -35,16 +35,19 @@ void source_point(const Intrinsics& k, const Distortion& distortion, int u, int 
 }  // namespace
 
 double share_sampled_outside(const Intrinsics& intrinsics, const Distortion& distortion) {
-  constexpr int kStride = 4;  // pixels: the bands beyond the lens's image are wider
-  int64_t outside = 0, all = 0;
-  for (int v = 0; v < intrinsics.height; v += kStride)
-    for (int u = 0; u < intrinsics.width; u += kStride) {
+  // The centers of a grid's cells, evenly over the frame: a share, not every pixel, is asked for.
+  constexpr int kGrid = 128;
+  const int columns = std::min(kGrid, intrinsics.width), rows = std::min(kGrid, intrinsics.height);
+  int64_t outside = 0;
+  for (int row = 0; row < rows; ++row)
+    for (int column = 0; column < columns; ++column) {
+      const double u = (column + 0.5) * intrinsics.width / columns;
+      const double v = (row + 0.5) * intrinsics.height / rows;
       double x, y;
       source_point(intrinsics, distortion, u, v, x, y);
       outside += !(x >= 0 && x <= intrinsics.width && y >= 0 && y <= intrinsics.height);
-      ++all;
     }
-  return all ? double(outside) / double(all) : 0;
+  return double(outside) / (double(columns) * rows);
 }
 
 Image8 undistort_image(const Image8& image, const Intrinsics& intrinsics,
@@ -54,7 +57,7 @@ Image8 undistort_image(const Image8& image, const Intrinsics& intrinsics,
   for (int v = 0; v < image.height; ++v)
     for (int u = 0; u < image.width; ++u) {
       double x, y;
-      source_point(intrinsics, distortion, u, v, x, y);
+      source_point(intrinsics, distortion, u + 0.5, v + 0.5, x, y);
       sample_bilinear(image, x, y, &out.at(u, v, 0));
     }
   return out;

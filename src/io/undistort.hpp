@@ -11,8 +11,8 @@ namespace iesrgs {
 Image8 undistort_image(const Image8& image, const Intrinsics& intrinsics,
                        const Distortion& distortion);
 
-// The share of those output pixels (on a grid of every 4th) whose samples fall outside the input,
-// where the lens's image does not reach the frame's edge and the border's pixels repeat.
+// The share of the output image (sampled at 128 x 128 points) whose samples fall outside the
+// input, where the lens's image does not reach the frame's edge and the border's pixels repeat.
 double share_sampled_outside(const Intrinsics& intrinsics, const Distortion& distortion);
 
 }  // namespace iesrgs

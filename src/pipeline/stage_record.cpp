@@ -4,10 +4,10 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
-#include <set>
 #include <string>
 #include <vector>
 
+#include "core/log_once.hpp"
 #include "io/atomic_file.hpp"
 #include "io/file_digest.hpp"
 #include "io/image.hpp"
@@ -46,8 +46,7 @@ bool params_match(const std::filesystem::path& dir, const nlohmann::json& record
     const std::string message =
         fmt::format("{}: recorded with other parameters ({})", (dir / "stage.json").string(),
                     fmt::join(changed, ", "));
-    static std::set<std::string> said;
-    if (said.insert(message).second) spdlog::debug(message);
+    debug_once(message);
   }
   return false;
 }

@@ -10,6 +10,7 @@
 #include "io/atomic_file.hpp"
 #include "io/colmap.hpp"
 #include "io/image.hpp"
+#include "support/captured_log.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -17,6 +18,9 @@ namespace iesrgs {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::CapturedLog;
+using testing::contains;
+using testing::error_message;
 using testing::TempDir;
 using testing::write_text;
 
@@ -380,9 +384,38 @@ TEST(Colmap, SparseComesBeforeAnyTransformsFile) {
   write_sample_scene(root.path());
   for (const char* name : {"transforms.json", "transforms_train.json"})
     write_text(root / name, "{}");  // read, either would fail
+  const CapturedLog log;
   const Scene scene = load_scene(root.path());
   EXPECT_EQ(scene.format, "colmap");
   EXPECT_EQ(scene.points.positions.size(), sample_model().points.size());
+  // Said once, however often the scene is loaded (`run` loads it twice).
+  load_scene(root.path());
+  EXPECT_EQ(log.count(root.path().string() +
+                      ": read as a COLMAP (it holds sparse/) scene; its transforms.json is not "
+                      "read (give that file's path to read it instead); its NeRF Synthetic split "
+                      "files are not read (they are read from a folder without sparse/)"),
+            1u)
+      << log.text();
+  // And a split file given alone names the folder's format.
+  const std::string message = error_message([&] { load_scene(root / "transforms_train.json"); });
+  EXPECT_TRUE(contains(message,
+                       "holds sparse/ and is read as a COLMAP scene: move the NeRF "
+                       "Synthetic files to a folder of their own"))
+      << message;
+}
+
+// The sample's RADIAL camera (k1 = 0.1) of frame_b pushes the frame's sides beyond its lens.
+TEST(Colmap, UndistortionThatRepeatsTheBorderIsSaidOnce) {
+  TempDir root;
+  write_sample_scene(root.path());
+  const CapturedLog log;
+  load_scene(root.path());
+  load_scene(root.path());
+  EXPECT_EQ(log.count("1 of the scene's 6 views, once undistorted, have pixels beyond what their "
+                      "lens saw, up to "),
+            1u)
+      << log.text();
+  EXPECT_EQ(log.count("% of a view (" + (root / "images" / "frame_b.jpg").string() + ")"), 1u);
 }
 
 // 3DGS's own points3D.ply stands in for points3D.bin; without either, the start is random.
@@ -413,10 +446,24 @@ TEST(Colmap, ACameraTakesTheSizeOfItsImagesWhenTheyAreItsSizeScaled) {
   EXPECT_EQ(half.height, 300);
   EXPECT_DOUBLE_EQ(half.fx, 700.25 / 2);
   EXPECT_DOUBLE_EQ(half.cy, 299.5 / 2);
-  // Another shape is no resize: refused when the image is decoded.
+  // A third of 800x600 is 266.7 x 200: either side of it rounded, or floored, fits.
+  write_png(root / "images" / "frame_a.jpg", Image8(267, 200, 3));
+  const CapturedLog log;
+  const Scene third = load_scene(root.path());
+  EXPECT_DOUBLE_EQ(camera_named(third, "frame_a").stored.fx, 700.25 * 267 / 800);
+  EXPECT_DOUBLE_EQ(camera_named(third, "frame_a").stored.fy, 710.75 / 3);
+  EXPECT_EQ(log.count("1 of its cameras are not the size of their images but that size scaled; "
+                      "their intrinsics are scaled to the images (first: camera 2, 800x600, "
+                      "whose frame_a.jpg is 267x200)"),
+            1u)
+      << log.text();
+  // Another shape is no resize, and an unreadable image no size: refused when decoded.
   write_png(root / "images" / "frame_a.jpg", Image8(400, 200, 3));
-  const Scene unfitted = load_scene(root.path());
-  EXPECT_EQ(camera_named(unfitted, "frame_a").stored.height, 600);
+  const Scene other_shape = load_scene(root.path());
+  EXPECT_EQ(camera_named(other_shape, "frame_a").stored.height, 600);
+  write_text(root / "images" / "frame_a.jpg", "not an image");
+  const Scene unreadable = load_scene(root.path());
+  EXPECT_EQ(camera_named(unreadable, "frame_a").stored.height, 600);
 }
 
 TEST(Colmap, TruncatedBinaryFilesNameTheFile) {
