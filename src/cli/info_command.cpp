@@ -39,7 +39,10 @@ void print_summary(const Scene& scene) {
   fmt::print("intrinsics  fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f} (fov {:.2f} x {:.2f} deg)\n",
              k.fx, k.fy, k.cx, k.cy, k.fov_x() * 180 / kPi, k.fov_y() * 180 / kPi);
   if (distorted)
-    fmt::print("distortion  {} cameras, undistorted to pinhole when loaded\n", distorted);
+    fmt::print(
+        "distortion  {} cameras, undistorted when loaded to the pinhole above, which sees "
+        "only what the lens saw\n",
+        distorted);
   fmt::print("points      {}\n", scene.points.positions.size());
   if (scene.points.positions.empty() && !scene.split(Split::Train).empty()) {
     const train::RandomBox box = train::random_box(scene, train::TrainConfig{});

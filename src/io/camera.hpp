@@ -61,6 +61,8 @@ struct Camera {
   std::filesystem::path image_path;  // full-resolution image as stored
   Intrinsics stored;                 // of the image at image_path
   Distortion distortion;  // of the stored image; loading undistorts it to a pinhole image
+  Intrinsics pinhole;     // the undistorted image's, at the stored size (`stored` when no lens
+                          // distortion): what `intrinsics` scales, set by load_scene
 
   Vec3 center() const { return -(rotation.transposed() * translation); }
   // One of the camera's axes in world coordinates (0 right, 1 down, 2 forward).

@@ -170,47 +170,19 @@ void require_pinhole_view(const Camera& camera) {
                         k.fx, k.fy, k.cx, k.cy, k.width, k.height, kWidestFieldOfView));
 }
 
-// Undistortion keeps each camera's intrinsics and size (io/undistort.hpp): where the lens's image
-// does not reach the frame's edge, the border's pixels repeat, and training takes them as seen.
-void warn_repeated_borders(const Scene& scene) {
-  std::map<std::array<double, 14>, double> share_of_lens;
-  size_t views = 0;
-  double largest = 0;
-  const Camera* widest = nullptr;
-  for (const Camera& camera : scene.cameras) {
-    const Intrinsics& k = camera.stored;
-    const Distortion& d = camera.distortion;
-    if (!d.any()) continue;
-    const std::array<double, 14> lens{double(k.width),
-                                      double(k.height),
-                                      k.fx,
-                                      k.fy,
-                                      k.cx,
-                                      k.cy,
-                                      d.k1,
-                                      d.k2,
-                                      d.p1,
-                                      d.p2,
-                                      d.k3,
-                                      d.k4,
-                                      d.k5,
-                                      d.k6};
-    const auto [it, added] = share_of_lens.emplace(lens, 0.0);
-    if (added) it->second = share_sampled_outside(k, d);
-    if (it->second == 0) continue;
-    ++views;
-    if (it->second > largest) {
-      largest = it->second;
-      widest = &camera;
-    }
-  }
-  if (!widest) return;
-  warn_once(fmt::format(
-      "{} of the scene's {} views, once undistorted, have pixels beyond what their lens saw, up "
-      "to {:.1f}% of a view ({}), where the image's border repeats and training takes it as "
-      "seen; undistorting and cropping the images beforehand (COLMAP's image_undistorter) "
-      "avoids it",
-      views, scene.cameras.size(), 100 * largest, widest->image_path.string()));
+// The pinhole model a view is rendered with: the image's own when it has no lens distortion, else
+// the widest that sees only what the lens saw (io/undistort.hpp), so that no border pixel repeats.
+Intrinsics pinhole_of(const Camera& camera) {
+  if (!camera.distortion.any()) return camera.stored;
+  if (const std::optional<Intrinsics> pinhole =
+          pinhole_within_lens(camera.stored, camera.distortion))
+    return *pinhole;
+  warn_once(
+      fmt::format("{}: its lens distortion cannot be inverted at the frame's edges, so it is "
+                  "undistorted with its own intrinsics, and pixels beyond what the lens saw "
+                  "repeat the image's border",
+                  camera.image_path.string()));
+  return camera.stored;
 }
 
 }  // namespace
@@ -295,14 +267,14 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   scene.downscale = options.downscale;
   for (Camera& camera : scene.cameras) {
     require_pinhole_view(camera);
-    camera.intrinsics = camera.stored.scaled(1.0 / options.downscale);
+    camera.pinhole = pinhole_of(camera);
+    camera.intrinsics = camera.pinhole.scaled(1.0 / options.downscale);
     if (camera.intrinsics.width < 1 || camera.intrinsics.height < 1)
       fail_file(camera.image_path,
                 fmt::format("at 1/{} of its {}x{} pixels, this view would have none; use a "
                             "smaller downscale or scale factor",
                             options.downscale, camera.stored.width, camera.stored.height));
   }
-  warn_repeated_borders(scene);
   return scene;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 namespace iesrgs {
 
@@ -23,44 +24,79 @@ void sample_bilinear(const Image8& image, double x, double y, uint8_t* out) {
   }
 }
 
-// Where the pinhole image's point (u, v) lies in the distorted image (image corner at 0).
-void source_point(const Intrinsics& k, const Distortion& distortion, double u, double v, double& x,
-                  double& y) {
-  double xd, yd;
-  distortion.apply((u - k.cx) / k.fx, (v - k.cy) / k.fy, xd, yd);
-  x = xd * k.fx + k.cx;
-  y = yd * k.fy + k.cy;
+// The normalized undistorted point that `distortion` maps to (xd, yd): Newton's method on
+// Distortion::apply, with a numeric Jacobian. False when it does not converge to a point the lens
+// saw: one on the same side of the axis, where the map has not folded back (a polynomial lens's
+// other roots lie beyond its fold, and no ray through them reached the image).
+bool invert(const Distortion& distortion, double xd, double yd, double& x, double& y) {
+  constexpr double kStep = 1e-7, kTolerance = 1e-10;
+  x = xd;
+  y = yd;
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    double ex, ey, xx, xy, yx, yy;
+    distortion.apply(x, y, ex, ey);
+    ex -= xd;
+    ey -= yd;
+    distortion.apply(x + kStep, y, xx, xy);
+    distortion.apply(x, y + kStep, yx, yy);
+    const double a = (xx - xd - ex) / kStep, c = (xy - yd - ey) / kStep;  // d/dx
+    const double b = (yx - xd - ex) / kStep, d = (yy - yd - ey) / kStep;  // d/dy
+    const double det = a * d - b * c;
+    if (std::abs(ex) < kTolerance && std::abs(ey) < kTolerance)
+      return det > 0 && x * xd + y * yd >= 0;
+    if (!(std::abs(det) > 1e-12)) return false;
+    x -= (d * ex - b * ey) / det;
+    y -= (a * ey - c * ex) / det;
+    if (!std::isfinite(x) || !std::isfinite(y)) return false;
+  }
+  return false;
 }
 
 }  // namespace
 
-double share_sampled_outside(const Intrinsics& intrinsics, const Distortion& distortion) {
-  // The centers of a grid's cells, evenly over the frame: a share, not every pixel, is asked for.
-  constexpr int kGrid = 128;
-  const int columns = std::min(kGrid, intrinsics.width), rows = std::min(kGrid, intrinsics.height);
-  int64_t outside = 0;
-  for (int row = 0; row < rows; ++row)
-    for (int column = 0; column < columns; ++column) {
-      const double u = (column + 0.5) * intrinsics.width / columns;
-      const double v = (row + 0.5) * intrinsics.height / rows;
-      double x, y;
-      source_point(intrinsics, distortion, u, v, x, y);
-      outside += !(x >= 0 && x <= intrinsics.width && y >= 0 && y <= intrinsics.height);
-    }
-  return double(outside) / (double(columns) * rows);
-}
-
-Image8 undistort_image(const Image8& image, const Intrinsics& intrinsics,
-                       const Distortion& distortion) {
+Image8 undistort_image(const Image8& image, const Intrinsics& lens, const Distortion& distortion,
+                       const Intrinsics& pinhole) {
   Image8 out(image.width, image.height, image.channels);
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < image.height; ++v)
     for (int u = 0; u < image.width; ++u) {
-      double x, y;
-      source_point(intrinsics, distortion, u + 0.5, v + 0.5, x, y);
-      sample_bilinear(image, x, y, &out.at(u, v, 0));
+      double xd, yd;
+      distortion.apply((u + 0.5 - pinhole.cx) / pinhole.fx, (v + 0.5 - pinhole.cy) / pinhole.fy, xd,
+                       yd);
+      sample_bilinear(image, xd * lens.fx + lens.cx, yd * lens.fy + lens.cy, &out.at(u, v, 0));
     }
   return out;
+}
+
+std::optional<Intrinsics> pinhole_within_lens(const Intrinsics& lens,
+                                              const Distortion& distortion) {
+  constexpr int kSamples = 256;  // along each side: the rectangle is as tight as their spacing
+  const double inf = std::numeric_limits<double>::infinity();
+  double left = -inf, right = inf, top = -inf, bottom = inf;
+  double x, y;
+  // A point of the frame's edge (pixels, corner at 0), undistorted.
+  const auto edge = [&](double px, double py) {
+    return invert(distortion, (px - lens.cx) / lens.fx, (py - lens.cy) / lens.fy, x, y);
+  };
+  for (int i = 0; i <= kSamples; ++i) {
+    const double along_x = lens.width * double(i) / kSamples;
+    const double along_y = lens.height * double(i) / kSamples;
+    if (!edge(0, along_y)) return std::nullopt;
+    left = std::max(left, x);
+    if (!edge(lens.width, along_y)) return std::nullopt;
+    right = std::min(right, x);
+    if (!edge(along_x, 0)) return std::nullopt;
+    top = std::max(top, y);
+    if (!edge(along_x, lens.height)) return std::nullopt;
+    bottom = std::min(bottom, y);
+  }
+  if (!(right > left && bottom > top)) return std::nullopt;
+  Intrinsics pinhole = lens;
+  pinhole.fx = lens.width / (right - left);
+  pinhole.cx = -left * pinhole.fx;
+  pinhole.fy = lens.height / (bottom - top);
+  pinhole.cy = -top * pinhole.fy;
+  return pinhole;
 }
 
 }  // namespace iesrgs

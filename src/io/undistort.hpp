@@ -1,18 +1,22 @@
 #pragma once
-// Undistortion of OpenCV-model (k1 k2 p1 p2) images to a pinhole image.
+// Undistortion of lens-distorted (OpenCV / COLMAP model) images to pinhole images.
+#include <optional>
+
 #include "io/camera.hpp"
 #include "io/image.hpp"
 
 namespace iesrgs {
 
-// Resamples `image` (taken with `intrinsics` and `distortion`) into the pinhole camera with the
-// same intrinsics: each output pixel is projected through the distortion and sampled bilinearly
-// from the input; samples outside the input are clamped to its border.
-Image8 undistort_image(const Image8& image, const Intrinsics& intrinsics,
-                       const Distortion& distortion);
+// Resamples `image` (taken with `lens` and `distortion`) into the pinhole camera `pinhole` of the
+// same size: each output pixel is projected through the distortion and sampled bilinearly from
+// the input; samples outside the input are clamped to its border.
+Image8 undistort_image(const Image8& image, const Intrinsics& lens, const Distortion& distortion,
+                       const Intrinsics& pinhole);
 
-// The share of the output image (sampled at 128 x 128 points) whose samples fall outside the
-// input, where the lens's image does not reach the frame's edge and the border's pixels repeat.
-double share_sampled_outside(const Intrinsics& intrinsics, const Distortion& distortion);
+// The pinhole camera of the lens's image size that sees only what the lens saw, as widely as that
+// allows: the rectangle inside the frame's edges once undistorted, as OpenCV's
+// getOptimalNewCameraMatrix with alpha 0 makes it for nerfstudio and gsplat. None when the
+// distortion cannot be inverted at the frame's edges.
+std::optional<Intrinsics> pinhole_within_lens(const Intrinsics& lens, const Distortion& distortion);
 
 }  // namespace iesrgs

@@ -39,11 +39,21 @@ fs::path downscaled_copy(const fs::path& scene_root, const fs::path& image_path,
 
 // Identifies an undistorted result: the source's content and every parameter used.
 std::string undistort_key(const std::string& source_digest, const Intrinsics& k,
-                          const Distortion& d) {
+                          const Distortion& d, const Intrinsics& pinhole) {
   return bytes_digest(
       fmt::format("{}|{}x{}|{:.9g},{:.9g},{:.9g},{:.9g}|{:.9g},{:.9g},{:.9g},{:.9g}", source_digest,
                   k.width, k.height, k.fx, k.fy, k.cx, k.cy, d.k1, d.k2, d.p1, d.p2) +
-      d.terms_beyond_opencv());
+      d.terms_beyond_opencv() +
+      fmt::format("|pinhole {:.9g},{:.9g},{:.9g},{:.9g}", pinhole.fx, pinhole.fy, pinhole.cx,
+                  pinhole.cy));
+}
+
+// `k`, of the stored image, for a copy of it `width` x `height` pixels.
+Intrinsics for_copy(const Intrinsics& k, int stored_width, int width, int height) {
+  Intrinsics copy = k.scaled(static_cast<double>(width) / stored_width);
+  copy.width = width;
+  copy.height = height;
+  return copy;
 }
 
 // Where a camera's size came from, for the error of an image that does not match it. A
@@ -76,10 +86,7 @@ Image8 ViewImages::read_source(const Camera& camera, Intrinsics& source_intrinsi
       fail_file(copy, fmt::format("image is {}x{}, expected about {} (1/{} of {})", image.width,
                                   image.height, describe(expected), scene_.downscale,
                                   describe(camera.stored)));
-    source_intrinsics =
-        camera.stored.scaled(static_cast<double>(image.width) / camera.stored.width);
-    source_intrinsics.width = image.width;
-    source_intrinsics.height = image.height;
+    source_intrinsics = for_copy(camera.stored, camera.stored.width, image.width, image.height);
     return image;
   }
   Image8 image = read_image8(camera.image_path);
@@ -93,9 +100,12 @@ Image8 ViewImages::read_source(const Camera& camera, Intrinsics& source_intrinsi
 
 Image8 ViewImages::undistorted(const Camera& camera, const Image8& source,
                                const Intrinsics& source_intrinsics) const {
+  const Intrinsics pinhole =
+      for_copy(camera.pinhole, camera.stored.width, source.width, source.height);
   const fs::path cached =
       options_.undistort_cache_dir /
-      (undistort_key(source_digest(camera), source_intrinsics, camera.distortion) + ".png");
+      (undistort_key(source_digest(camera), source_intrinsics, camera.distortion, pinhole) +
+       ".png");
   std::error_code ec;
   if (fs::is_regular_file(cached, ec)) {
     try {
@@ -107,7 +117,7 @@ Image8 ViewImages::undistorted(const Camera& camera, const Image8& source,
       spdlog::warn("ignoring unreadable undistortion cache entry: {}", e.what());
     }
   }
-  Image8 image = undistort_image(source, source_intrinsics, camera.distortion);
+  Image8 image = undistort_image(source, source_intrinsics, camera.distortion, pinhole);
   try {
     write_png(cached, image);
   } catch (const Error& e) {

@@ -3,9 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
+#include <optional>
 #include <random>
+#include <utility>
 
 namespace iesrgs {
 namespace {
@@ -68,7 +72,7 @@ TEST(Undistort, DistortedPatternBecomesThePinholePattern) {
     SCOPED_TRACE(d.k1);
     const Image8 pinhole = render_pattern(k, {});
     const Image8 distorted = render_pattern(k, d);
-    const Image8 undistorted = undistort_image(distorted, k, d);
+    const Image8 undistorted = undistort_image(distorted, k, d, k);
     ASSERT_EQ(undistorted.width, 160);
     ASSERT_EQ(undistorted.height, 120);
     ASSERT_EQ(undistorted.channels, 1);
@@ -94,7 +98,7 @@ TEST(Undistort, ZeroDistortionIsTheIdentity) {
   const Intrinsics k{37, 23, 30, 31, 18.1, 11.9};
   for (int channels : {1, 3, 4}) {
     const Image8 image = random_image(37, 23, channels);
-    const Image8 out = undistort_image(image, k, {});
+    const Image8 out = undistort_image(image, k, {}, k);
     EXPECT_EQ(out.channels, channels);
     EXPECT_EQ(out.data, image.data);
   }
@@ -104,7 +108,7 @@ TEST(Undistort, SamplesOutsideTheImageClampToTheBorder) {
   const Intrinsics k{40, 30, 20, 20, 20, 15};
   const Image8 image = random_image(40, 30, 3);
   // The corners' rays land far outside the distorted image.
-  const Image8 out = undistort_image(image, k, {5, 0, 0, 0});
+  const Image8 out = undistort_image(image, k, {5, 0, 0, 0}, k);
   for (int c = 0; c < 3; ++c) {
     EXPECT_EQ(out.at(0, 0, c), image.at(0, 0, c));
     EXPECT_EQ(out.at(39, 0, c), image.at(39, 0, c));
@@ -112,16 +116,62 @@ TEST(Undistort, SamplesOutsideTheImageClampToTheBorder) {
   }
 }
 
-// Pincushion pushes the frame's edges beyond the lens's image; barrel pulls the image's edges in.
-TEST(Undistort, TheShareSampledOutsideIsWhereTheBorderRepeats) {
-  const Intrinsics k{400, 300, 200, 200, 200, 150};
-  EXPECT_EQ(share_sampled_outside(k, {}), 0);
-  EXPECT_EQ(share_sampled_outside(k, {-0.05, 0, 0, 0}), 0);
-  // At the middle of the frame's side (x = 1), the ray lands 1 + k1 = 1.1 out: 20 px beyond.
-  const double pincushion = share_sampled_outside(k, {0.1, 0, 0, 0});
-  EXPECT_GT(pincushion, 0.02);
-  EXPECT_LT(pincushion, 0.2);
-  EXPECT_GT(share_sampled_outside(k, {0.5, 0, 0, 0}), pincushion);
+// How far inside the lens's frame (pixels; negative: outside) each side of the pinhole's frame
+// comes, at its nearest: 0 where the two touch.
+std::array<double, 4> margins(const Intrinsics& lens, const Distortion& d,
+                              const Intrinsics& pinhole) {
+  std::array<double, 4> margin;
+  margin.fill(std::numeric_limits<double>::infinity());
+  const auto lens_point = [&](double u, double v, double& x, double& y) {
+    double xd, yd;
+    d.apply((u - pinhole.cx) / pinhole.fx, (v - pinhole.cy) / pinhole.fy, xd, yd);
+    x = xd * lens.fx + lens.cx;
+    y = yd * lens.fy + lens.cy;
+  };
+  double x, y;
+  for (int i = 0; i <= 1000; ++i) {
+    const double u = pinhole.width * i / 1000.0, v = pinhole.height * i / 1000.0;
+    lens_point(0, v, x, y);
+    margin[0] = std::min(margin[0], x);
+    lens_point(pinhole.width, v, x, y);
+    margin[1] = std::min(margin[1], lens.width - x);
+    lens_point(u, 0, x, y);
+    margin[2] = std::min(margin[2], y);
+    lens_point(u, pinhole.height, x, y);
+    margin[3] = std::min(margin[3], lens.height - y);
+  }
+  return margin;
+}
+
+// As nerfstudio and gsplat undistort (OpenCV's alpha 0): every pixel samples what the lens saw,
+// and the frame is no smaller than that needs: a side reaches the lens's edge (the others may
+// not, where the point that bounds them falls outside the span of the sides across).
+TEST(Undistort, ThePinholeWithinTheLensSeesOnlyWhatTheLensSaw) {
+  const Intrinsics lens{400, 300, 200, 210, 205, 148};
+  const Intrinsics fox{1080, 1920, 1375.52, 1374.49, 554.558, 965.268};
+  const std::pair<Intrinsics, Distortion> cases[] = {
+      {lens, {0.1, 0, 0, 0}},
+      {lens, {-0.2, 0.03, 0.002, -0.001}},
+      {lens, {-0.2, 0.03, 0.002, -0.001, 0.02, 0.1, -0.02, 0.01}},
+      {fox, {0.0578421, -0.0805099, -0.000980296, 0.00015575}}};
+  for (const auto& [k, d] : cases) {
+    SCOPED_TRACE(d.k1);
+    const std::optional<Intrinsics> pinhole = pinhole_within_lens(k, d);
+    ASSERT_TRUE(pinhole);
+    EXPECT_EQ(pinhole->width, k.width);
+    EXPECT_EQ(pinhole->height, k.height);
+    const std::array<double, 4> margin = margins(k, d, *pinhole);
+    for (double side : margin) EXPECT_GT(side, -0.01);
+    EXPECT_LT(*std::min_element(margin.begin(), margin.end()), 0.01);
+  }
+  // Pincushion leaves the frame's sides beyond the lens's image: the pinhole sees less (longer
+  // focal lengths); barrel brings more of the scene into the frame: it sees more.
+  EXPECT_GT(pinhole_within_lens(lens, {0.1, 0, 0, 0})->fx, lens.fx);
+  EXPECT_LT(pinhole_within_lens(lens, {-0.05, 0, 0, 0})->fx, lens.fx);
+  // r (1 - 0.2 r^2) folds back at r = 1.29, short of the frame's corners (1.24 after it): they
+  // were not seen through this lens, nor through fox's on this wider frame.
+  EXPECT_FALSE(pinhole_within_lens(lens, {-0.2, 0, 0, 0}));
+  EXPECT_FALSE(pinhole_within_lens(lens, cases[3].second));
 }
 
 }  // namespace
