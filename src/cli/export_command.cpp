@@ -7,6 +7,7 @@
 #include "cli/commands.hpp"
 #include "core/error.hpp"
 #include "core/paths.hpp"
+#include "io/atomic_file.hpp"
 #include "io/model_file.hpp"
 #include "io/ply.hpp"
 #include "io/splat_file.hpp"
@@ -35,6 +36,7 @@ void run_export(const ExportArgs& args) {
   const SplatCloud cloud = read_model(model);
   // An empty .splat is an empty file, which no reader can tell from a damaged one.
   if (cloud.size() == 0) fail_file(model, "holds no Gaussians: nothing to export");
+  remove_stale_temporaries_of(output);  // what an export killed mid-write left
   size_t written = cloud.size();
   if (format == ".splat")
     written = write_splat(output, cloud);

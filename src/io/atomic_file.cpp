@@ -117,6 +117,18 @@ void remove_stale_temporaries(const fs::path& folder) {
   }
 }
 
+void remove_stale_temporaries_of(const fs::path& file) {
+  const std::string prefix = file.filename().string() + std::string(kTemporaryMark);
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  std::error_code walk;
+  for (fs::directory_iterator it(folder, walk), end; !walk && it != end; it.increment(walk)) {
+    std::error_code ec;  // as above: what cannot be checked or removed is left alone
+    if (it->path().filename().string().rfind(prefix, 0) == 0 && it->is_regular_file(ec) &&
+        is_stale_temporary(it->path()))
+      fs::remove(it->path(), ec);
+  }
+}
+
 void remove_temporaries_in_progress() {
   for (const InProgressSlot& slot : in_progress)
     if (slot.listed) ::unlink(slot.name);

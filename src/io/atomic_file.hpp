@@ -24,6 +24,10 @@ constexpr int kOutputFolderDepth = 4;
 // writer is gone.
 void remove_stale_temporaries(const std::filesystem::path& folder);
 
+// The same for the temporaries of `file` alone ("<file>.tmp-<pid>", beside it): for outputs
+// written into any folder (export, eval), which no FolderLock takes.
+void remove_stale_temporaries_of(const std::filesystem::path& file);
+
 // Removes the temporaries this process is writing now. Async-signal-safe: for the handler that
 // ends the process on a signal (end_on_signals), so that Ctrl-C leaves no half-written file.
 void remove_temporaries_in_progress();

@@ -35,6 +35,21 @@ TEST(AtomicFile, TheTemporaryBeingWrittenIsListedForRemoval) {
   EXPECT_TRUE(fs::exists(dir / "done.json"));
 }
 
+// Beside a file written into any folder (export's, eval's), only that file's temporaries that a
+// killed writer left go (no process has a pid of 999999999), and not a running writer's.
+TEST(AtomicFile, AFilesOwnStaleTemporariesAreRemoved) {
+  TempDir dir;
+  const std::string running = std::to_string(::getppid());
+  const char* stale = "model.spz.tmp-999999999";
+  const std::string kept[] = {"model.spz.tmp-" + running, "other.spz.tmp-999999999",
+                              "model.spz.tmp-x"};
+  std::ofstream(dir / stale) << "x";
+  for (const std::string& name : kept) std::ofstream(dir / name) << "x";
+  remove_stale_temporaries_of(dir / "model.spz");
+  EXPECT_FALSE(fs::exists(dir / stale));
+  for (const std::string& name : kept) EXPECT_TRUE(fs::exists(dir / name)) << name;
+}
+
 // Ctrl-C while a file is written, outside training: the process ends as the signal ends it, and
 // neither the file nor its temporary is left.
 TEST(AtomicFile, ASignalMidWriteLeavesNoHalfWrittenFile) {
