@@ -20,46 +20,21 @@ namespace iesrgs {
 
 namespace fs = std::filesystem;
 
+// The temporaries being written, and the folders created for outputs, for a signal handler to
+// remove. Each slot keeps its own copy of the name, so that a handler on another thread only ever
+// reads a name, never memory its writer has freed.
+struct InProgressSlot {
+  std::atomic<bool> taken{false};
+  std::atomic<bool> listed{false};  // `name` is complete
+  bool folder = false;
+  char name[4096];
+};
+
 namespace {
 
 constexpr std::string_view kTemporaryMark = ".tmp-";
 
-// The temporaries being written, for a signal handler to remove. Each slot keeps its own copy of
-// the name, so that a handler on another thread only ever reads a temporary's name, never memory
-// its writer has freed.
-struct InProgressSlot {
-  std::atomic<bool> taken{false};
-  std::atomic<bool> listed{false};  // `name` is complete
-  char name[4096];
-};
 std::array<InProgressSlot, 64> in_progress;
-
-// Lists a temporary in `in_progress` while it is written; one beyond the slots, or with a longer
-// name, is not listed (the next command taking its folder removes it).
-class InProgress {
- public:
-  explicit InProgress(const std::string& name) {
-    if (name.size() >= sizeof(InProgressSlot::name)) return;
-    for (InProgressSlot& slot : in_progress) {
-      bool free = false;
-      if (!slot.taken.compare_exchange_strong(free, true)) continue;
-      std::memcpy(slot.name, name.c_str(), name.size() + 1);
-      slot.listed = true;
-      slot_ = &slot;
-      return;
-    }
-  }
-  ~InProgress() {
-    if (!slot_) return;
-    slot_->listed = false;
-    slot_->taken = false;
-  }
-  InProgress(const InProgress&) = delete;
-  InProgress& operator=(const InProgress&) = delete;
-
- private:
-  InProgressSlot* slot_ = nullptr;
-};
 
 fs::path temporary_path(const fs::path& path) {
   return path.string() + std::string(kTemporaryMark) + std::to_string(::getpid());
@@ -129,9 +104,35 @@ void remove_stale_temporaries_of(const fs::path& file) {
   }
 }
 
+InProgress::InProgress(const std::string& path, bool folder) {
+  if (path.size() >= sizeof(InProgressSlot::name)) return;
+  for (InProgressSlot& slot : in_progress) {
+    bool free = false;
+    if (!slot.taken.compare_exchange_strong(free, true)) continue;
+    std::memcpy(slot.name, path.c_str(), path.size() + 1);
+    slot.folder = folder;
+    slot.listed = true;
+    slot_ = &slot;
+    return;
+  }
+}
+
+InProgress::~InProgress() {
+  if (!slot_) return;
+  slot_->listed = false;
+  slot_->taken = false;
+}
+
 void remove_temporaries_in_progress() {
   for (const InProgressSlot& slot : in_progress)
-    if (slot.listed) ::unlink(slot.name);
+    if (slot.listed && !slot.folder) ::unlink(slot.name);
+  // Folders once the files in them are gone, and again while one goes: a parent listed before
+  // its child is empty only after it.
+  for (bool removed = true; removed;) {
+    removed = false;
+    for (const InProgressSlot& slot : in_progress)
+      if (slot.listed && slot.folder && ::rmdir(slot.name) == 0) removed = true;
+  }
 }
 
 void write_file_atomically(const fs::path& path, const std::string& bytes) {

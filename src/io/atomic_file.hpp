@@ -28,8 +28,26 @@ void remove_stale_temporaries(const std::filesystem::path& folder);
 // written into any folder (export, eval), which no FolderLock takes.
 void remove_stale_temporaries_of(const std::filesystem::path& file);
 
-// Removes the temporaries this process is writing now. Async-signal-safe: for the handler that
-// ends the process on a signal (end_on_signals), so that Ctrl-C leaves no half-written file.
+struct InProgressSlot;
+
+// While alive, lists `path` for remove_temporaries_in_progress: a temporary being written, or a
+// `folder` this process created for its outputs, removed only while still empty. One beyond the
+// 64 slots, or a path of 4096 bytes or more, is not listed (the next command taking its folder
+// removes a temporary).
+class InProgress {
+ public:
+  explicit InProgress(const std::string& path, bool folder = false);
+  ~InProgress();
+  InProgress(const InProgress&) = delete;
+  InProgress& operator=(const InProgress&) = delete;
+
+ private:
+  InProgressSlot* slot_ = nullptr;
+};
+
+// Removes the temporaries this process is writing now, then the listed folders left empty.
+// Async-signal-safe: for the handler that ends the process on a signal (end_on_signals), so that
+// Ctrl-C leaves no half-written file, and no empty output folder.
 void remove_temporaries_in_progress();
 
 // Removes `file`, an earlier output about to be replaced, when it exists; returns whether it did.

@@ -3,7 +3,10 @@
 // folder (a resume started while the first still runs, say) would interleave checkpoints, logs
 // and cached stages.
 #include <filesystem>
+#include <memory>
 #include <vector>
+
+#include "io/atomic_file.hpp"
 
 namespace iesrgs {
 
@@ -11,8 +14,9 @@ namespace iesrgs {
 // drops the lock when the process ends, however it ends, so a crash leaves nothing stale.
 // Throws Error naming the folder when another process holds it, a folder above it or one of the
 // folders up to four levels below it. On a file system without locks, the folder is used
-// unlocked. Folders it created that are still empty when it is released are removed, so a
-// command refused after taking the lock leaves no trace. Taking it removes the temporaries a
+// unlocked. Folders it created that are still empty when it is released, or when a signal ends
+// the process (remove_temporaries_in_progress), are removed, so a command refused or stopped
+// before its first output leaves no trace. Taking it removes the temporaries a
 // killed writer left in the folder and below (remove_stale_temporaries).
 class FolderLock {
  public:
@@ -26,7 +30,8 @@ class FolderLock {
   void release();
 
   int fd_ = -1;
-  std::vector<std::filesystem::path> created_;  // the folder first, then its new parents
+  std::vector<std::filesystem::path> created_;       // the folder first, then its new parents
+  std::vector<std::unique_ptr<InProgress>> listed_;  // created_, for a signal to remove
 };
 
 }  // namespace iesrgs

@@ -1,10 +1,15 @@
 #include "io/folder_lock.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <csignal>
 #include <fstream>
 #include <optional>
 
+#include "core/interrupt.hpp"
+#include "io/atomic_file.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -60,6 +65,32 @@ TEST(FolderLock, FoldersItCreatedAndLeftEmptyAreRemoved) {
   std::filesystem::create_directory(dir / "given");
   { FolderLock unused(dir / "given"); }
   EXPECT_TRUE(std::filesystem::is_directory(dir / "given"));  // the user's own folder stays
+}
+
+// Ctrl-C before the first output: the folders the lock created go with the temporary, as they do
+// when it is released; with an output in them, they stay.
+TEST(FolderLock, ASignalRemovesTheFoldersItCreatedWhileEmpty) {
+  TempDir dir;
+  for (bool with_output : {false, true}) {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      end_on_signals(remove_temporaries_in_progress);
+      const FolderLock lock(dir / "new" / "out");
+      if (with_output) write_file_atomically(dir / "new" / "out" / "done.json", "{}");
+      write_atomically(dir / "new" / "out" / "model.ply", [](const std::filesystem::path& tmp) {
+        std::ofstream(tmp) << "half";
+        std::raise(SIGINT);
+      });
+      ::_exit(0);  // not reached
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status)) << status;
+    EXPECT_EQ(std::filesystem::exists(dir / "new" / "out" / "done.json"), with_output);
+    EXPECT_EQ(std::filesystem::exists(dir / "new"), with_output);
+    EXPECT_FALSE(std::filesystem::exists(dir / "new" / "out" / "model.ply"));
+  }
 }
 
 // A writer killed mid-write leaves "<name>.tmp-<pid>". Only our outputs' temporaries go, in the
