@@ -40,8 +40,8 @@ void print_summary(const Scene& scene) {
              k.fx, k.fy, k.cx, k.cy, k.fov_x() * 180 / kPi, k.fov_y() * 180 / kPi);
   if (distorted)
     fmt::print(
-        "distortion  {} cameras, undistorted when loaded to the pinhole above, which sees "
-        "only what the lens saw\n",
+        "distortion  {} cameras, undistorted when loaded (the intrinsics above are the first "
+        "camera's after it)\n",
         distorted);
   fmt::print("points      {}\n", scene.points.positions.size());
   if (scene.points.positions.empty() && !scene.split(Split::Train).empty()) {

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/log_once.hpp"
@@ -172,17 +173,13 @@ void require_pinhole_view(const Camera& camera) {
 
 // The pinhole model a view is rendered with: the image's own when it has no lens distortion, else
 // the widest that sees only what the lens saw (io/undistort.hpp), so that no border pixel repeats.
-Intrinsics pinhole_of(const Camera& camera) {
-  if (!camera.distortion.any()) return camera.stored;
-  if (const std::optional<Intrinsics> pinhole =
-          pinhole_within_lens(camera.stored, camera.distortion))
-    return *pinhole;
-  warn_once(
-      fmt::format("{}: its lens distortion cannot be inverted at the frame's edges, so it is "
-                  "undistorted with its own intrinsics, and pixels beyond what the lens saw "
-                  "repeat the image's border",
-                  camera.image_path.string()));
-  return camera.stored;
+// False when the lens folds back before the frame's edges, where it keeps its own.
+bool set_pinhole(Camera& camera) {
+  camera.pinhole = camera.stored;
+  if (!camera.distortion.any()) return true;
+  const std::optional<Intrinsics> pinhole = pinhole_within_lens(camera.stored, camera.distortion);
+  if (pinhole) camera.pinhole = *pinhole;
+  return pinhole.has_value();
 }
 
 }  // namespace
@@ -265,9 +262,10 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   scene.background = options.background.value_or(scene.synthetic ? std::array<float, 3>{1, 1, 1}
                                                                  : std::array<float, 3>{0, 0, 0});
   scene.downscale = options.downscale;
+  std::vector<const Camera*> folded;
   for (Camera& camera : scene.cameras) {
     require_pinhole_view(camera);
-    camera.pinhole = pinhole_of(camera);
+    if (!set_pinhole(camera)) folded.push_back(&camera);
     camera.intrinsics = camera.pinhole.scaled(1.0 / options.downscale);
     if (camera.intrinsics.width < 1 || camera.intrinsics.height < 1)
       fail_file(camera.image_path,
@@ -275,6 +273,12 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
                             "smaller downscale or scale factor",
                             options.downscale, camera.stored.width, camera.stored.height));
   }
+  if (!folded.empty())
+    warn_once(
+        fmt::format("{} of the scene's {} views ({} first): the lens distortion folds back "
+                    "before the frame's edges, where it cannot be undone, so they keep the "
+                    "lens's own intrinsics",
+                    folded.size(), scene.cameras.size(), folded.front()->image_path.string()));
   return scene;
 }
 

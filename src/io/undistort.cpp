@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 
 namespace iesrgs {
 
@@ -24,14 +25,12 @@ void sample_bilinear(const Image8& image, double x, double y, uint8_t* out) {
   }
 }
 
-// The normalized undistorted point that `distortion` maps to (xd, yd): Newton's method on
-// Distortion::apply, with a numeric Jacobian. False when it does not converge to a point the lens
-// saw: one on the same side of the axis, where the map has not folded back (a polynomial lens's
-// other roots lie beyond its fold, and no ray through them reached the image).
+// Moves (x, y) to the normalized undistorted point that `distortion` maps to (xd, yd), by
+// Newton's method on Distortion::apply with a numeric Jacobian, starting from (x, y). False when
+// it does not converge, or converges where the map has folded back (a non-positive Jacobian):
+// no ray through such a point reached the image.
 bool invert(const Distortion& distortion, double xd, double yd, double& x, double& y) {
   constexpr double kStep = 1e-7, kTolerance = 1e-10;
-  x = xd;
-  y = yd;
   for (int iteration = 0; iteration < 50; ++iteration) {
     double ex, ey, xx, xy, yx, yy;
     distortion.apply(x, y, ex, ey);
@@ -42,14 +41,28 @@ bool invert(const Distortion& distortion, double xd, double yd, double& x, doubl
     const double a = (xx - xd - ex) / kStep, c = (xy - yd - ey) / kStep;  // d/dx
     const double b = (yx - xd - ex) / kStep, d = (yy - yd - ey) / kStep;  // d/dy
     const double det = a * d - b * c;
-    if (std::abs(ex) < kTolerance && std::abs(ey) < kTolerance)
-      return det > 0 && x * xd + y * yd >= 0;
+    if (std::abs(ex) < kTolerance && std::abs(ey) < kTolerance) return det > 0;
     if (!(std::abs(det) > 1e-12)) return false;
     x -= (d * ex - b * ey) / det;
     y -= (a * ey - c * ex) / det;
     if (!std::isfinite(x) || !std::isfinite(y)) return false;
   }
   return false;
+}
+
+// Inverts the lens along a path of distorted normalized points, each solve starting from the
+// last one's root, so that the roots stay on the branch the lens saw: a polynomial lens has
+// other roots beyond its fold, which a solve started far from the axis can land on. Calls
+// take(x, y) with each root; false where the inverse breaks off.
+template <typename Path, typename Take>
+bool follow(const Distortion& distortion, int steps, const Path& path, double& x, double& y,
+            const Take& take) {
+  for (int i = 1; i <= steps; ++i) {
+    const auto [xd, yd] = path(double(i) / steps);
+    if (!invert(distortion, xd, yd, x, y)) return false;
+    take(x, y);
+  }
+  return true;
 }
 
 }  // namespace
@@ -70,27 +83,54 @@ Image8 undistort_image(const Image8& image, const Intrinsics& lens, const Distor
 
 std::optional<Intrinsics> pinhole_within_lens(const Intrinsics& lens,
                                               const Distortion& distortion) {
-  constexpr int kSamples = 256;  // along each side: the rectangle is as tight as their spacing
-  const double inf = std::numeric_limits<double>::infinity();
-  double left = -inf, right = inf, top = -inf, bottom = inf;
-  double x, y;
-  // A point of the frame's edge (pixels, corner at 0), undistorted.
-  const auto edge = [&](double px, double py) {
-    return invert(distortion, (px - lens.cx) / lens.fx, (py - lens.cy) / lens.fy, x, y);
+  constexpr int kAxisSteps = 32, kSideSteps = 128;  // the rectangle is as tight as their spacing
+  using Point = std::pair<double, double>;
+  const auto normalized = [&](const Point& pixel) -> Point {
+    return {(pixel.first - lens.cx) / lens.fx, (pixel.second - lens.cy) / lens.fy};
   };
-  for (int i = 0; i <= kSamples; ++i) {
-    const double along_x = lens.width * double(i) / kSamples;
-    const double along_y = lens.height * double(i) / kSamples;
-    if (!edge(0, along_y)) return std::nullopt;
-    left = std::max(left, x);
-    if (!edge(lens.width, along_y)) return std::nullopt;
-    right = std::min(right, x);
-    if (!edge(along_x, 0)) return std::nullopt;
-    top = std::max(top, y);
-    if (!edge(along_x, lens.height)) return std::nullopt;
-    bottom = std::min(bottom, y);
-  }
-  if (!(right > left && bottom > top)) return std::nullopt;
+  // One side of the frame, frame_point(t) for t in [0, 1] (pixels, corner at 0), undistorted:
+  // reached from the optical axis at its middle, then followed to both ends. `take` sees the
+  // side's points; those on the way from the axis lie inside the frame and bound nothing.
+  const auto side = [&](const auto& frame_point, const auto& take) {
+    const Point middle = normalized(frame_point(0.5));
+    const auto toward_middle = [&](double t) -> Point {
+      return {middle.first * t, middle.second * t};
+    };
+    double x = 0, y = 0;
+    if (!follow(distortion, kAxisSteps, toward_middle, x, y, [](double, double) {})) return false;
+    take(x, y);
+    for (const double end : {0.0, 1.0}) {
+      const auto toward_end = [&](double t) {
+        return normalized(frame_point(0.5 + (end - 0.5) * t));
+      };
+      double ex = x, ey = y;
+      if (!follow(distortion, kSideSteps, toward_end, ex, ey, take)) return false;
+    }
+    return true;
+  };
+  const double w = lens.width, h = lens.height, inf = std::numeric_limits<double>::infinity();
+  double left = -inf, right = inf, top = -inf, bottom = inf;
+  const bool inverted = side(
+                            [&](double t) {
+                              return Point{0, t * h};
+                            },
+                            [&](double x, double) { left = std::max(left, x); }) &&
+                        side(
+                            [&](double t) {
+                              return Point{w, t * h};
+                            },
+                            [&](double x, double) { right = std::min(right, x); }) &&
+                        side(
+                            [&](double t) {
+                              return Point{t * w, 0};
+                            },
+                            [&](double, double y) { top = std::max(top, y); }) &&
+                        side(
+                            [&](double t) {
+                              return Point{t * w, h};
+                            },
+                            [&](double, double y) { bottom = std::min(bottom, y); });
+  if (!inverted || !(right > left && bottom > top)) return std::nullopt;
   Intrinsics pinhole = lens;
   pinhole.fx = lens.width / (right - left);
   pinhole.cx = -left * pinhole.fx;

@@ -257,7 +257,8 @@ void Trainer::require_same_cameras() const {
   if (stored != cameras_json(train_cameras_))
     fail_file(saved,
               "the run trained on other cameras than the scene given now: resume with the same "
-              "scene, --downscale and --test-every");
+              "scene, --downscale and --test-every (a version of iesrgs that undistorts the "
+              "scene's lens otherwise changes its cameras too: start the training over then)");
 }
 
 // K distinct views drawn afresh each step: multi-view regulation. The code of 3DGS and MVGS pops

@@ -94,6 +94,23 @@ TEST(Undistort, DistortedPatternBecomesThePinholePattern) {
   }
 }
 
+// Into the pinhole within the lens, every pixel shows the pattern as that pinhole sees it.
+TEST(Undistort, IntoThePinholeWithinTheLensEveryPixelIsThePinholesView) {
+  const Intrinsics k{160, 120, 100, 95, 81.3, 58.7};
+  for (const Distortion& d :
+       {Distortion{-0.25, 0.05, 0.004, -0.003}, Distortion{0.3, -0.1, 0, 0}}) {
+    SCOPED_TRACE(d.k1);
+    const Intrinsics pinhole = pinhole_within_lens(k, d).value();
+    ASSERT_GT(std::abs(pinhole.fx - k.fx), 2);  // another camera than the lens's own
+    const Image8 expected = render_pattern(pinhole, {});
+    const Image8 undistorted = undistort_image(render_pattern(k, d), k, d, pinhole);
+    int worst = 0;
+    for (size_t i = 0; i < expected.data.size(); ++i)
+      worst = std::max(worst, std::abs(undistorted.data[i] - expected.data[i]));
+    EXPECT_LE(worst, 3);
+  }
+}
+
 TEST(Undistort, ZeroDistortionIsTheIdentity) {
   const Intrinsics k{37, 23, 30, 31, 18.1, 11.9};
   for (int channels : {1, 3, 4}) {
@@ -164,6 +181,13 @@ TEST(Undistort, ThePinholeWithinTheLensSeesOnlyWhatTheLensSaw) {
     for (double side : margin) EXPECT_GT(side, -0.01);
     EXPECT_LT(*std::min_element(margin.begin(), margin.end()), 0.01);
   }
+  // Solved from a distorted corner alone, this wide pincushion lens lands beyond its fold; the
+  // inverse followed from the axis finds the point the lens saw.
+  const Intrinsics wide{400, 300, 150, 150, 200, 150};
+  const Distortion wide_lens{0.351, -0.095, 0.0105, 0.0148};
+  const std::optional<Intrinsics> wide_pinhole = pinhole_within_lens(wide, wide_lens);
+  ASSERT_TRUE(wide_pinhole);
+  for (double side : margins(wide, wide_lens, *wide_pinhole)) EXPECT_GT(side, -0.01);
   // Pincushion leaves the frame's sides beyond the lens's image: the pinhole sees less (longer
   // focal lengths); barrel brings more of the scene into the frame: it sees more.
   EXPECT_GT(pinhole_within_lens(lens, {0.1, 0, 0, 0})->fx, lens.fx);

@@ -22,7 +22,7 @@ Camera camera_for(const std::filesystem::path& path, int w, int h) {
   camera.name = path.stem().string();
   camera.image_path = path;
   camera.stored = {w, h, double(w), double(w), w / 2.0, h / 2.0};
-  camera.intrinsics = camera.stored;
+  camera.intrinsics = camera.pinhole = camera.stored;  // as load_scene sets them
   return camera;
 }
 
