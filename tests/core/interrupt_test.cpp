@@ -2,9 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -12,25 +9,15 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "support/ended_by.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs {
 namespace {
 
+using testing::ended_by;
 using testing::error_message;
-
-// The signal that ended a child process running `work`, 0 when it ended normally.
-int ended_by(const std::function<void()>& work) {
-  const pid_t child = ::fork();
-  if (child == 0) {
-    work();
-    ::_exit(0);
-  }
-  int status = 0;
-  ::waitpid(child, &status, 0);
-  return WIFSIGNALED(status) ? WTERMSIG(status) : 0;
-}
 
 TEST(Interrupt, ASignalInsideAScopeAsksTheWorkToStop) {
   const InterruptScope scope;

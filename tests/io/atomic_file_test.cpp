@@ -1,7 +1,6 @@
 #include "io/atomic_file.hpp"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -9,6 +8,7 @@
 #include <fstream>
 
 #include "core/interrupt.hpp"
+#include "support/ended_by.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs {
@@ -54,20 +54,14 @@ TEST(AtomicFile, AFilesOwnStaleTemporariesAreRemoved) {
 // neither the file nor its temporary is left.
 TEST(AtomicFile, ASignalMidWriteLeavesNoHalfWrittenFile) {
   TempDir dir;
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    end_on_signals(remove_temporaries_in_progress);
-    write_atomically(dir / "model.ply", [](const fs::path& tmp) {
-      std::ofstream(tmp) << "half";
-      std::raise(SIGINT);
-    });
-    ::_exit(0);  // not reached
-  }
-  int status = 0;
-  ASSERT_EQ(::waitpid(child, &status, 0), child);
-  ASSERT_TRUE(WIFSIGNALED(status)) << status;
-  EXPECT_EQ(WTERMSIG(status), SIGINT);
+  EXPECT_EQ(testing::ended_by([&] {
+              end_on_signals(remove_temporaries_in_progress);
+              write_atomically(dir / "model.ply", [](const fs::path& tmp) {
+                std::ofstream(tmp) << "half";
+                std::raise(SIGINT);
+              });
+            }),
+            SIGINT);
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 

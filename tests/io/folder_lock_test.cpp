@@ -1,15 +1,13 @@
 #include "io/folder_lock.hpp"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <csignal>
 #include <fstream>
 #include <optional>
 
 #include "core/interrupt.hpp"
 #include "io/atomic_file.hpp"
+#include "support/ended_by.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -72,21 +70,17 @@ TEST(FolderLock, FoldersItCreatedAndLeftEmptyAreRemoved) {
 TEST(FolderLock, ASignalRemovesTheFoldersItCreatedWhileEmpty) {
   TempDir dir;
   for (bool with_output : {false, true}) {
-    const pid_t child = ::fork();
-    ASSERT_GE(child, 0);
-    if (child == 0) {
-      end_on_signals(remove_temporaries_in_progress);
-      const FolderLock lock(dir / "new" / "out");
-      if (with_output) write_file_atomically(dir / "new" / "out" / "done.json", "{}");
-      write_atomically(dir / "new" / "out" / "model.ply", [](const std::filesystem::path& tmp) {
-        std::ofstream(tmp) << "half";
-        std::raise(SIGINT);
-      });
-      ::_exit(0);  // not reached
-    }
-    int status = 0;
-    ASSERT_EQ(::waitpid(child, &status, 0), child);
-    ASSERT_TRUE(WIFSIGNALED(status)) << status;
+    EXPECT_EQ(testing::ended_by([&] {
+                end_on_signals(remove_temporaries_in_progress);
+                const FolderLock lock(dir / "new" / "out");
+                if (with_output) write_file_atomically(dir / "new" / "out" / "done.json", "{}");
+                write_atomically(dir / "new" / "out" / "model.ply",
+                                 [](const std::filesystem::path& tmp) {
+                                   std::ofstream(tmp) << "half";
+                                   std::raise(SIGINT);
+                                 });
+              }),
+              SIGINT);
     EXPECT_EQ(std::filesystem::exists(dir / "new" / "out" / "done.json"), with_output);
     EXPECT_EQ(std::filesystem::exists(dir / "new"), with_output);
     EXPECT_FALSE(std::filesystem::exists(dir / "new" / "out" / "model.ply"));
