@@ -360,8 +360,14 @@ FusionSetup Pipeline::fusion_setup(const RowSpec& row, const loss::FusionWeights
   }
   setup.cameras = hr_train_cameras();
   const std::vector<ExternalView>& external = row.source == Source::Bicubic ? bicubic_ : external_;
+  if (external.size() != setup.cameras.size())
+    fail("the external stage made {} views for {} HR training views", external.size(),
+         setup.cameras.size());
   for (size_t i = 0; i < setup.cameras.size(); ++i) {
     const std::string& name = setup.cameras[i].name;
+    // Each view's references are its own: a view trained on another's would still train.
+    if (external[i].name != name)
+      fail("HR training view {} is {}, its external references {}'s", i, name, external[i].name);
     ReferenceFiles files{external[i].image, external[i].depth, {}, {}};
     if (internal_) {
       const RenderedViewFiles rendered = rendered_view_files(internal_->sr_dir, name);
