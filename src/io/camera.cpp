@@ -12,7 +12,7 @@ const char* split_name(Split split) {
 
 std::string Distortion::terms_beyond_opencv() const {
   if (!beyond_opencv()) return {};
-  return fmt::format(" {:.9g} {:.9g} {:.9g} {:.9g}", k3, k4, k5, k6);
+  return fmt::format("{} {:.9g} {:.9g} {:.9g} {:.9g}", fisheye ? " fisheye" : "", k3, k4, k5, k6);
 }
 
 Intrinsics Intrinsics::scaled(double scale) const {

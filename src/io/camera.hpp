@@ -1,6 +1,7 @@
 #pragma once
 // A posed pinhole camera in the OpenCV convention used everywhere inside iesrgs:
 // x right, y down, z forward; world-to-camera p_cam = R * p_world + t.
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -18,26 +19,38 @@ constexpr int kMaxImageSide = 1 << 16;
 
 const char* split_name(Split split);
 
-// Lens distortion of the stored image, in the OpenCV / COLMAP model: radial k1, k2, k3 over
-// k4, k5, k6 (FULL_OPENCV's rational model; OPENCV's is k1, k2 alone), tangential p1, p2. All zero
-// means the image is already pinhole.
+// Lens distortion of the stored image, in the OpenCV / COLMAP models. Perspective: radial k1, k2,
+// k3 over k4, k5, k6 (FULL_OPENCV's rational model; OPENCV's is k1, k2 alone), tangential p1, p2;
+// all zero means the image is already pinhole. Fisheye (OPENCV_FISHEYE and its simpler kin): the
+// equidistant projection, the ray at angle theta from the axis imaged at radius
+// theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8); the other terms unused.
 struct Distortion {
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0;
   double k3 = 0, k4 = 0, k5 = 0, k6 = 0;
+  bool fisheye = false;
 
   bool any() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || beyond_opencv(); }
-  bool beyond_opencv() const { return k3 != 0 || k4 != 0 || k5 != 0 || k6 != 0; }
+  bool beyond_opencv() const { return fisheye || k3 != 0 || k4 != 0 || k5 != 0 || k6 != 0; }
   // Maps normalized undistorted coordinates (x, y) to distorted ones. Zero terms add exact zeros,
   // so an OPENCV lens maps as it did before the other terms were read.
   void apply(double x, double y, double& xd, double& yd) const {
     const double r2 = x * x + y * y;
+    if (fisheye) {
+      const double r = std::sqrt(r2), theta = std::atan(r), t2 = theta * theta;
+      const double imaged = theta * (1 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))));
+      const double scale = r > 1e-12 ? imaged / r : 1.0;  // theta / r -> 1 on the axis
+      xd = x * scale;
+      yd = y * scale;
+      return;
+    }
     const double radial = (1 + k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2) /
                           (1 + k4 * r2 + k5 * r2 * r2 + k6 * r2 * r2 * r2);
     xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
     yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
   }
-  // " k3 k4 k5 k6" for the keys of what an undistortion made, or nothing when they are all zero:
-  // the keys of OPENCV lenses stay those made before these terms were read.
+  // " k3 k4 k5 k6" (" fisheye k3 k4 k5 k6" for a fisheye) for the keys of what an undistortion
+  // made, or nothing for a perspective lens whose are all zero: the keys of OPENCV lenses stay
+  // those made before these terms were read.
   std::string terms_beyond_opencv() const;
 };
 

@@ -112,10 +112,12 @@ void write_colmap_model_text(const fs::path& dir, const ColmapModel& model) {
 namespace {
 
 // Where the pinhole and distortion terms sit in a supported model's parameters; -1: the model
-// has no such term (zero). The SIMPLE_ models share one focal length between x and y.
+// has no such term (zero). The SIMPLE_ models share one focal length between x and y. The fisheye
+// models' k1..k4 are those of Distortion's equidistant projection.
 struct PinholeLayout {
   std::string_view model;
   int fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6;
+  bool fisheye = false;
 };
 
 constexpr PinholeLayout kSupportedModels[] = {
@@ -125,6 +127,11 @@ constexpr PinholeLayout kSupportedModels[] = {
     {"RADIAL", 0, 0, 1, 2, 3, 4, -1, -1, -1, -1, -1, -1},
     {"OPENCV", 0, 1, 2, 3, 4, 5, 6, 7, -1, -1, -1, -1},
     {"FULL_OPENCV", 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11},
+    {"SIMPLE_FISHEYE", 0, 0, 1, 2, -1, -1, -1, -1, -1, -1, -1, -1, true},
+    {"FISHEYE", 0, 1, 2, 3, -1, -1, -1, -1, -1, -1, -1, -1, true},
+    {"SIMPLE_RADIAL_FISHEYE", 0, 0, 1, 2, 3, -1, -1, -1, -1, -1, -1, -1, true},
+    {"RADIAL_FISHEYE", 0, 0, 1, 2, 3, 4, -1, -1, -1, -1, -1, -1, true},
+    {"OPENCV_FISHEYE", 0, 1, 2, 3, 4, 5, -1, -1, 6, 7, -1, -1, true},
 };
 
 const PinholeLayout& supported_layout(const ColmapCamera& camera, const fs::path& cameras_file) {
@@ -162,8 +169,9 @@ Lens lens_of(const ColmapCamera& camera, const fs::path& cameras_file) {
                      param(layout.cy)};
   if (!(lens.intrinsics.fx > 0 && lens.intrinsics.fy > 0))
     fail_file(cameras_file, fmt::format("camera {}: focal length must be positive", camera.id));
-  lens.distortion = {param(layout.k1), param(layout.k2), param(layout.p1), param(layout.p2),
-                     param(layout.k3), param(layout.k4), param(layout.k5), param(layout.k6)};
+  lens.distortion = {param(layout.k1), param(layout.k2), param(layout.p1),
+                     param(layout.p2), param(layout.k3), param(layout.k4),
+                     param(layout.k5), param(layout.k6), layout.fisheye};
   return lens;
 }
 

@@ -258,8 +258,10 @@ Intrinsics nerfstudio_intrinsics(const FrameKeys& keys, const fs::path& image_pa
   return k;
 }
 
-// The camera models nerfstudio takes for perspective cameras (its CAMERA_MODEL_TO_TYPE).
-constexpr const char* kPerspectiveModels = "SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV";
+// The camera models nerfstudio takes for perspective cameras (its CAMERA_MODEL_TO_TYPE), and its
+// fisheye one.
+constexpr const char* kSupportedModels =
+    "SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, OPENCV_FISHEYE";
 
 bool is_perspective_model(const std::string& model) {
   return model == "SIMPLE_PINHOLE" || model == "PINHOLE" || model == "SIMPLE_RADIAL" ||
@@ -271,24 +273,32 @@ Distortion nerfstudio_distortion(const FrameKeys& keys) {
   // as OPENCV, its images would be undistorted wrongly without a word.
   if (const json* fisheye = keys.find("is_fisheye"); fisheye && *fisheye == true)
     keys.where("is_fisheye")
-        .fail(
-            "fisheye lenses (\"is_fisheye\": true) are not supported (supported: the "
-            "perspective models, " +
-            std::string(kPerspectiveModels) + ")");
+        .fail(fmt::format("instant-ngp's fisheye lenses (\"is_fisheye\": true) are not supported "
+                          "(supported: \"camera_model\" {})",
+                          kSupportedModels));
   const std::string model = keys.string("camera_model").value_or("PINHOLE");
-  if (!is_perspective_model(model))
-    keys.where("camera_model")
-        .fail(fmt::format("unsupported \"camera_model\" {} (supported: the perspective models, {})",
-                          quoted(json(model)), kPerspectiveModels));
-  // nerfstudio's k4 is a fourth radial term of its own, OpenCV's the first of a denominator.
-  if (keys.number("k4").value_or(0) != 0)
-    keys.where("k4").fail("\"k4\" is not supported (supported: k1 k2 k3 p1 p2)");
-  // As nerfstudio and instant-ngp, the coefficients apply whichever of these models is named: all
-  // are perspective cameras to them.
   Distortion d;
   d.k1 = keys.number("k1").value_or(0);
   d.k2 = keys.number("k2").value_or(0);
   d.k3 = keys.number("k3").value_or(0);
+  // nerfstudio's fisheye: OpenCV's, k1..k4 on the ray's angle.
+  if (model == "OPENCV_FISHEYE") {
+    d.k4 = keys.number("k4").value_or(0);
+    d.fisheye = true;
+    return d;
+  }
+  if (!is_perspective_model(model))
+    keys.where("camera_model")
+        .fail(fmt::format("unsupported \"camera_model\" {} (supported: {})", quoted(json(model)),
+                          kSupportedModels));
+  // nerfstudio's perspective k4 is a fourth radial term of its own, OpenCV's the first of a
+  // denominator.
+  if (keys.number("k4").value_or(0) != 0)
+    keys.where("k4").fail(
+        "\"k4\" is not supported by the perspective models (supported: k1 k2 "
+        "k3 p1 p2)");
+  // As nerfstudio and instant-ngp, the coefficients apply whichever of these models is named: all
+  // are perspective cameras to them.
   d.p1 = keys.number("p1").value_or(0);
   d.p2 = keys.number("p2").value_or(0);
   return d;

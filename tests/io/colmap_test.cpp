@@ -570,11 +570,35 @@ TEST(Colmap, MalformedTextNamesFileAndLine) {
 TEST(Colmap, UnsupportedCameraModelIsNamed) {
   TempDir root;
   ColmapModel model = sample_model();
-  model.cameras[3] = {3, "OPENCV_FISHEYE", 100, 100, {1, 1, 50, 50, 0, 0, 0, 0}};
+  model.cameras[3] = {3, "FOV", 100, 100, {1, 1, 50, 50, 0.5}};
   write_colmap_model_text(root / "sparse/0", model);
   expect_error([&] { load_scene(root.path()); },
-               {(root / "sparse/0/cameras.txt").string(), "OPENCV_FISHEYE",
-                "SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV"});
+               {(root / "sparse/0/cameras.txt").string(), "FOV",
+                "SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV, "
+                "SIMPLE_FISHEYE, FISHEYE, SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE, OPENCV_FISHEYE"});
+}
+
+// A fisheye's terms bend the ray's angle, and its views render with the pinhole within it.
+TEST(Colmap, FisheyeCamerasKeepTheirTerms) {
+  TempDir root;
+  ColmapModel model = sample_model();
+  model.cameras[5] = {
+      5, "OPENCV_FISHEYE", 1920, 1080, {1500, 1490, 960, 540, 0.1, -0.02, 0.003, 0}};
+  model.cameras[3] = {3, "SIMPLE_RADIAL_FISHEYE", 1024, 768, {900, 512, 384, 0.05}};
+  write_colmap_model_text(root / "sparse/0", model);
+  const Scene scene = load_scene(root.path());
+  const Camera& opencv = camera_named(scene, "frame_d");
+  EXPECT_TRUE(opencv.distortion.fisheye);
+  EXPECT_EQ(opencv.distortion.k1, 0.1);
+  EXPECT_EQ(opencv.distortion.k2, -0.02);
+  EXPECT_EQ(opencv.distortion.k3, 0.003);
+  EXPECT_EQ(opencv.distortion.p1, 0);
+  // The equidistant image holds more at its edges than a pinhole of its focal length would.
+  EXPECT_LT(opencv.pinhole.fx, opencv.stored.fx);
+  const Camera& simple = camera_named(scene, "frame_e");
+  EXPECT_TRUE(simple.distortion.fisheye);
+  EXPECT_EQ(simple.distortion.k1, 0.05);
+  EXPECT_EQ(simple.stored.fy, 900);
 }
 
 TEST(Colmap, FullOpencvKeepsItsRationalTerms) {
@@ -599,7 +623,7 @@ TEST(Colmap, FullOpencvKeepsItsRationalTerms) {
 TEST(Colmap, UnusedCameraOfAnyModelIsIgnored) {
   TempDir root;
   ColmapModel model = sample_model();
-  model.cameras[9] = {9, "OPENCV_FISHEYE", 100, 100, {1, 1, 50, 50, 0, 0, 0, 0}};
+  model.cameras[9] = {9, "FOV", 100, 100, {1, 1, 50, 50, 0.5}};
   write_colmap_model_text(root / "sparse/0", model);
   EXPECT_EQ(load_scene(root.path()).cameras.size(), model.images.size());
 }

@@ -351,6 +351,13 @@ TEST(NerfstudioScene, CameraModels) {
     EXPECT_DOUBLE_EQ(d.k1, 0.1) << model;
     EXPECT_DOUBLE_EQ(d.k3, 0.02) << model;
   }
+  // nerfstudio's fisheye: k1..k4 on the ray's angle, k4 its own.
+  document["camera_model"] = "OPENCV_FISHEYE";
+  document["k4"] = 0.004;
+  d = parse_in_memory(document).cameras[0].distortion;
+  EXPECT_TRUE(d.fisheye);
+  EXPECT_DOUBLE_EQ(d.k1, 0.1);
+  EXPECT_DOUBLE_EQ(d.k4, 0.004);
 }
 
 // A rig's folders keep the same file names: the folder below the one all images share stays in
@@ -470,9 +477,9 @@ TEST(NerfstudioScene, BadInputGivesOneLineErrorNamingFileAndProblem) {
       {"huge height",
        edited([](json& d) { d["frames"][1]["h"] = 1e9; }),
        {"frame 1: \"h\" must be an integer image size"}},
-      {"fisheye",
-       edited([](json& d) { d["camera_model"] = "OPENCV_FISHEYE"; }),
-       {"unsupported \"camera_model\" \"OPENCV_FISHEYE\""}},
+      {"equirectangular",
+       edited([](json& d) { d["camera_model"] = "EQUIRECTANGULAR"; }),
+       {"unsupported \"camera_model\" \"EQUIRECTANGULAR\""}},
       {"instant-ngp fisheye",
        edited([](json& d) {
          d["k1"] = 0.05;

@@ -97,8 +97,9 @@ TEST(Undistort, DistortedPatternBecomesThePinholePattern) {
 // Into the pinhole within the lens, every pixel shows the pattern as that pinhole sees it.
 TEST(Undistort, IntoThePinholeWithinTheLensEveryPixelIsThePinholesView) {
   const Intrinsics k{160, 120, 100, 95, 81.3, 58.7};
+  const Distortion fisheye{0.05, 0.01, 0, 0, 0, 0, 0, 0, true};
   for (const Distortion& d :
-       {Distortion{-0.25, 0.05, 0.004, -0.003}, Distortion{0.3, -0.1, 0, 0}}) {
+       {Distortion{-0.25, 0.05, 0.004, -0.003}, Distortion{0.3, -0.1, 0, 0}, fisheye}) {
     SCOPED_TRACE(d.k1);
     const Intrinsics pinhole = pinhole_within_lens(k, d).value();
     ASSERT_GT(std::abs(pinhole.fx - k.fx), 2);  // another camera than the lens's own
@@ -170,7 +171,8 @@ TEST(Undistort, ThePinholeWithinTheLensSeesOnlyWhatTheLensSaw) {
       {lens, {0.1, 0, 0, 0}},
       {lens, {-0.2, 0.03, 0.002, -0.001}},
       {lens, {-0.2, 0.03, 0.002, -0.001, 0.02, 0.1, -0.02, 0.01}},
-      {fox, {0.0578421, -0.0805099, -0.000980296, 0.00015575}}};
+      {fox, {0.0578421, -0.0805099, -0.000980296, 0.00015575}},
+      {lens, {0.05, 0.01, 0, 0, -0.002, 0.0005, 0, 0, true}}};  // a fisheye
   for (const auto& [k, d] : cases) {
     SCOPED_TRACE(d.k1);
     const std::optional<Intrinsics> pinhole = pinhole_within_lens(k, d);
@@ -196,6 +198,10 @@ TEST(Undistort, ThePinholeWithinTheLensSeesOnlyWhatTheLensSaw) {
   // were not seen through this lens, nor through fox's on this wider frame.
   EXPECT_FALSE(pinhole_within_lens(lens, {-0.2, 0, 0, 0}));
   EXPECT_FALSE(pinhole_within_lens(lens, cases[3].second));
+  // The equidistant projection images a ray at 90 degrees at radius pi / 2: a frame reaching past
+  // it saw beyond what any pinhole sees.
+  const Distortion equidistant{0, 0, 0, 0, 0, 0, 0, 0, true};
+  EXPECT_FALSE(pinhole_within_lens({400, 300, 100, 100, 200, 150}, equidistant));
 }
 
 }  // namespace
