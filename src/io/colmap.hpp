@@ -73,7 +73,9 @@ void write_colmap_model_binary(const std::filesystem::path& dir, const ColmapMod
 void write_colmap_model_text(const std::filesystem::path& dir, const ColmapModel& model);
 
 // `root` holds sparse/0 (or sparse/) and images/; every `test_every`-th image by name is test.
-// Cameras must be SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV or FULL_OPENCV.
+// Cameras must be SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV or one of
+// the equidistant fisheyes (SIMPLE_FISHEYE, FISHEYE, SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE,
+// OPENCV_FISHEYE).
 Scene read_colmap_scene(const std::filesystem::path& root, const SceneOptions& options);
 
 }  // namespace iesrgs

@@ -275,9 +275,10 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   }
   if (!folded.empty())
     warn_once(
-        fmt::format("{} of the scene's {} views ({} first): the lens distortion folds back "
-                    "before the frame's edges, where it cannot be undone, so they keep the "
-                    "lens's own intrinsics",
+        fmt::format("{} of the scene's {} views ({} first): the lens cannot be undone out to "
+                    "the frame's edges (its distortion folds back, or a fisheye's frame reaches "
+                    "past 90 degrees), so they keep the lens's own intrinsics and show less than "
+                    "it saw",
                     folded.size(), scene.cameras.size(), folded.front()->image_path.string()));
   return scene;
 }

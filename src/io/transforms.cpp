@@ -281,8 +281,14 @@ Distortion nerfstudio_distortion(const FrameKeys& keys) {
   d.k1 = keys.number("k1").value_or(0);
   d.k2 = keys.number("k2").value_or(0);
   d.k3 = keys.number("k3").value_or(0);
-  // nerfstudio's fisheye: OpenCV's, k1..k4 on the ray's angle.
+  // nerfstudio's fisheye: OpenCV's, k1..k4 on the ray's angle. Its tangential terms, which
+  // nerfstudio's rays apply and its splatting undistortion drops, are refused rather than guessed.
   if (model == "OPENCV_FISHEYE") {
+    for (const char* tangential : {"p1", "p2"})
+      if (keys.number(tangential).value_or(0) != 0)
+        keys.where(tangential)
+            .fail(fmt::format("\"{}\" is not supported by OPENCV_FISHEYE (supported: k1 k2 k3 k4)",
+                              tangential));
     d.k4 = keys.number("k4").value_or(0);
     d.fisheye = true;
     return d;

@@ -17,10 +17,10 @@ namespace iesrgs {
 Scene read_blender_scene(const std::filesystem::path& root, const SceneOptions& options);
 
 // `transforms_json` in the nerfstudio / instant-ngp convention: per-scene or per-frame
-// intrinsics (fl_x, fl_y, cx, cy, w, h or camera_angle_x/y), camera models PINHOLE and OPENCV
-// (k1 k2 k3 p1 p2 under either). Frames sorted by file_path; the file's split lists
-// (train_filenames, test_filenames or val_filenames) set the split when it has them, else every
-// `test_every`-th frame, starting with the first, is held out for test (LLFF convention). The
+// intrinsics (fl_x, fl_y, cx, cy, w, h or camera_angle_x/y), the perspective camera models (k1 k2
+// k3 p1 p2 under any) and OPENCV_FISHEYE (k1..k4). Frames sorted by file_path; the file's split
+// lists (train_filenames, test_filenames or val_filenames) set the split when it has them, else
+// every `test_every`-th frame, starting with the first, is held out for test (LLFF convention). The
 // points of its ply_file_path (nerfstudio's SfM points, in the frames' coordinates) start training.
 Scene read_nerfstudio_scene(const std::filesystem::path& transforms_json,
                             const SceneOptions& options);

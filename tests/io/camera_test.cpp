@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "io/camera.hpp"
 #include "support/looking_cameras.hpp"
 #include "support/projection.hpp"
@@ -58,6 +60,25 @@ TEST(Camera, DistortionModelMatchesOpenCv) {
   EXPECT_NEAR(xd, 0.3 * radial + 2 * 0.001 * 0.3 * -0.2 + -0.002 * (r2 + 2 * 0.09), 1e-15);
   EXPECT_NEAR(yd, -0.2 * radial + 0.001 * (r2 + 2 * 0.04) + 2 * -0.002 * 0.3 * -0.2, 1e-15);
   EXPECT_FALSE(Distortion{}.any());
+}
+
+// OpenCV's fisheye: a ray at 45 degrees (x = 1 on the normalized plane) is imaged at radius
+// theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8), theta = pi / 4.
+TEST(Camera, FisheyeModelMatchesOpenCv) {
+  const double theta = std::atan(1.0), t2 = theta * theta;
+  double xd, yd;
+  Distortion equidistant;
+  equidistant.fisheye = true;
+  EXPECT_TRUE(equidistant.any());
+  equidistant.apply(1, 0, xd, yd);
+  EXPECT_NEAR(xd, theta, 1e-15);
+  EXPECT_EQ(yd, 0);
+  const Distortion d{0.1, -0.05, 0, 0, 0.02, -0.01, 0, 0, true};
+  d.apply(0.6, 0.8, xd, yd);  // r = 1: the same ray, turned
+  const double imaged =
+      theta * (1 + 0.1 * t2 - 0.05 * t2 * t2 + 0.02 * t2 * t2 * t2 - 0.01 * t2 * t2 * t2 * t2);
+  EXPECT_NEAR(xd, 0.6 * imaged, 1e-15);
+  EXPECT_NEAR(yd, 0.8 * imaged, 1e-15);
 }
 
 TEST(Camera, FocusPointIsWhereTheOpticalAxesMeet) {

@@ -583,22 +583,29 @@ TEST(Colmap, FisheyeCamerasKeepTheirTerms) {
   TempDir root;
   ColmapModel model = sample_model();
   model.cameras[5] = {
-      5, "OPENCV_FISHEYE", 1920, 1080, {1500, 1490, 960, 540, 0.1, -0.02, 0.003, 0}};
-  model.cameras[3] = {3, "SIMPLE_RADIAL_FISHEYE", 1024, 768, {900, 512, 384, 0.05}};
+      5, "OPENCV_FISHEYE", 1920, 1080, {1500, 1490, 960, 540, 0.1, -0.02, 0.003, -0.0004}};
+  model.cameras[3] = {3, "RADIAL_FISHEYE", 1024, 768, {900, 512, 384, 0.05, 0.01}};
+  model.cameras[1] = {1, "SIMPLE_FISHEYE", 640, 480, {500, 320, 240}};
   write_colmap_model_text(root / "sparse/0", model);
   const Scene scene = load_scene(root.path());
-  const Camera& opencv = camera_named(scene, "frame_d");
-  EXPECT_TRUE(opencv.distortion.fisheye);
-  EXPECT_EQ(opencv.distortion.k1, 0.1);
-  EXPECT_EQ(opencv.distortion.k2, -0.02);
-  EXPECT_EQ(opencv.distortion.k3, 0.003);
-  EXPECT_EQ(opencv.distortion.p1, 0);
-  // The equidistant image holds more at its edges than a pinhole of its focal length would.
-  EXPECT_LT(opencv.pinhole.fx, opencv.stored.fx);
-  const Camera& simple = camera_named(scene, "frame_e");
+  const Distortion& opencv = camera_named(scene, "frame_d").distortion;
+  EXPECT_TRUE(opencv.fisheye);
+  EXPECT_EQ(opencv.k1, 0.1);
+  EXPECT_EQ(opencv.k2, -0.02);
+  EXPECT_EQ(opencv.k3, 0.003);
+  EXPECT_EQ(opencv.k4, -0.0004);
+  EXPECT_EQ(opencv.p1, 0);
+  const Camera& radial = camera_named(scene, "frame_e");
+  EXPECT_TRUE(radial.distortion.fisheye);
+  EXPECT_EQ(radial.distortion.k1, 0.05);
+  EXPECT_EQ(radial.distortion.k2, 0.01);
+  EXPECT_EQ(radial.stored.fy, 900);
+  // Equidistant alone: still a lens to undo. Its image holds more at its edges than a pinhole of
+  // its focal length: the pinhole within it has shorter ones.
+  const Camera& simple = camera_named(scene, "frame_c");
   EXPECT_TRUE(simple.distortion.fisheye);
-  EXPECT_EQ(simple.distortion.k1, 0.05);
-  EXPECT_EQ(simple.stored.fy, 900);
+  EXPECT_EQ(simple.distortion.k1, 0);
+  EXPECT_LT(simple.pinhole.fx, simple.stored.fx);
 }
 
 TEST(Colmap, FullOpencvKeepsItsRationalTerms) {

@@ -18,6 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using testing::contains;
 using testing::error_message;
 using testing::project;
 using testing::TempDir;
@@ -351,9 +352,12 @@ TEST(NerfstudioScene, CameraModels) {
     EXPECT_DOUBLE_EQ(d.k1, 0.1) << model;
     EXPECT_DOUBLE_EQ(d.k3, 0.02) << model;
   }
-  // nerfstudio's fisheye: k1..k4 on the ray's angle, k4 its own.
+  // nerfstudio's fisheye: k1..k4 on the ray's angle, k4 its own; tangential terms are refused.
   document["camera_model"] = "OPENCV_FISHEYE";
   document["k4"] = 0.004;
+  EXPECT_TRUE(contains(error_message([&] { parse_in_memory(document); }),
+                       "\"p2\" is not supported by OPENCV_FISHEYE"));
+  document.erase("p2");
   d = parse_in_memory(document).cameras[0].distortion;
   EXPECT_TRUE(d.fisheye);
   EXPECT_DOUBLE_EQ(d.k1, 0.1);
