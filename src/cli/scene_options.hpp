@@ -18,8 +18,9 @@ struct SceneArgs {
   void add_to(CLI::App& command, const std::string& what = kSceneHelp);
 
   static constexpr const char* kSceneHelp =
-      "Scene: a folder with transforms_train.json (NeRF Synthetic), transforms.json (nerfstudio / "
-      "instant-ngp) or sparse/0 (COLMAP), or a transforms.json file";
+      "Scene: a folder with sparse/0 or sparse/ (COLMAP), transforms_train.json (NeRF Synthetic) "
+      "or transforms.json (nerfstudio / instant-ngp), looked for in that order, or a "
+      "transforms.json file";
   // Validated SceneOptions (parses --background).
   SceneOptions resolved() const;
 };
