@@ -2,12 +2,19 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace iesrgs {
 
 const char* split_name(Split split) {
   return split == Split::Train ? "train" : "test";
+}
+
+std::string view_name(const std::filesystem::path& image_below_folder) {
+  std::string name = std::filesystem::path(image_below_folder).replace_extension().generic_string();
+  std::replace(name.begin(), name.end(), '/', '_');
+  return name;
 }
 
 std::string Distortion::terms_beyond_opencv() const {

@@ -19,6 +19,10 @@ constexpr int kMaxImageSide = 1 << 16;
 
 const char* split_name(Split split);
 
+// A view's name: its image's path below the folder its scene names views from, without the
+// extension, '/' as '_' (a rig's cam0/000.png and cam1/000.png are cam0_000 and cam1_000).
+std::string view_name(const std::filesystem::path& image_below_folder);
+
 // Lens distortion of the stored image, in the OpenCV / COLMAP models. Perspective: radial k1, k2,
 // k3 over k4, k5, k6 (FULL_OPENCV's rational model; OPENCV's is k1, k2 alone), tangential p1, p2;
 // all zero means the image is already pinhole. Fisheye (OPENCV_FISHEYE and its simpler kin): the
@@ -65,8 +69,8 @@ struct Intrinsics {
 };
 
 struct Camera {
-  std::string name;  // image file stem (path below COLMAP's images/, '/' as '_'), unique per
-                     // split: renders and per-view outputs are named after it
+  std::string name;  // view_name of the image (below COLMAP's images/, nerfstudio's shared
+                     // folder), unique per split: renders and per-view outputs are named after it
   Split split = Split::Train;
   Intrinsics intrinsics;             // the pinhole model the renderer uses (after --downscale)
   Mat3 rotation;                     // world-to-camera

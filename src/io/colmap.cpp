@@ -206,8 +206,7 @@ Camera camera_of(const ColmapImage& image, const Lens& lens, const fs::path& roo
               fmt::format("image '{}': rotation quaternion cannot be normalized", image.name));
   Camera camera;
   // Rigs keep one folder per camera with the same file names in each: the folder stays in the name.
-  camera.name = fs::path(image.name).replace_extension().generic_string();
-  std::replace(camera.name.begin(), camera.name.end(), '/', '_');
+  camera.name = view_name(image.name);
   camera.image_path = root / "images" / image.name;
   camera.stored = lens.intrinsics;
   camera.intrinsics = lens.intrinsics;
@@ -273,21 +272,23 @@ Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
       fail_file(files.images, fmt::format("image '{}' is listed twice (ids {} and {})",
                                           images[i]->name, images[i - 1]->id, images[i]->id));
   std::set<uint32_t> seen;
-  std::vector<std::string> fitted;  // what each fit was, for the warning
+  size_t fitted = 0;
+  std::string first_fit;  // for the warning
   for (const ColmapImage* image : images) {
     if (!seen.insert(image->camera_id).second) continue;
     Lens& lens = lenses.at(image->camera_id);
     const Intrinsics before = lens.intrinsics;
-    if (fit_lens_to_image(lens, root / "images" / image->name))
-      fitted.push_back(fmt::format("camera {}, {}x{}, whose {} is {}x{}", image->camera_id,
-                                   before.width, before.height, image->name, lens.intrinsics.width,
-                                   lens.intrinsics.height));
+    if (!fit_lens_to_image(lens, root / "images" / image->name)) continue;
+    if (fitted++ == 0)
+      first_fit =
+          fmt::format("camera {}, {}x{}, whose {} is {}x{}", image->camera_id, before.width,
+                      before.height, image->name, lens.intrinsics.width, lens.intrinsics.height);
   }
-  if (!fitted.empty())
+  if (fitted > 0)
     warn_once(
         fmt::format("{}: {} of its cameras are not the size of their images but that size "
                     "scaled; their intrinsics are scaled to the images (first: {})",
-                    files.cameras.string(), fitted.size(), fitted.front()));
+                    files.cameras.string(), fitted, first_fit));
 
   Scene scene;
   scene.root = root;

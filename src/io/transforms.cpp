@@ -437,10 +437,8 @@ void name_below_common_folder(std::vector<std::pair<std::string, Camera>>& camer
   fs::path common = cameras.front().second.image_path.parent_path();
   for (const auto& [file_path, camera] : cameras)
     common = common_folder(common, camera.image_path.parent_path());
-  for (auto& [file_path, camera] : cameras) {
-    camera.name = camera.image_path.lexically_relative(common).replace_extension().generic_string();
-    std::replace(camera.name.begin(), camera.name.end(), '/', '_');
-  }
+  for (auto& [file_path, camera] : cameras)
+    camera.name = view_name(camera.image_path.lexically_relative(common));
 }
 
 Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_path,

@@ -109,27 +109,15 @@ std::optional<Intrinsics> pinhole_within_lens(const Intrinsics& lens,
     return true;
   };
   const double w = lens.width, h = lens.height, inf = std::numeric_limits<double>::infinity();
+  const auto left_edge = [&](double t) { return Point{0, t * h}; };
+  const auto right_edge = [&](double t) { return Point{w, t * h}; };
+  const auto top_edge = [&](double t) { return Point{t * w, 0}; };
+  const auto bottom_edge = [&](double t) { return Point{t * w, h}; };
   double left = -inf, right = inf, top = -inf, bottom = inf;
-  const bool inverted = side(
-                            [&](double t) {
-                              return Point{0, t * h};
-                            },
-                            [&](double x, double) { left = std::max(left, x); }) &&
-                        side(
-                            [&](double t) {
-                              return Point{w, t * h};
-                            },
-                            [&](double x, double) { right = std::min(right, x); }) &&
-                        side(
-                            [&](double t) {
-                              return Point{t * w, 0};
-                            },
-                            [&](double, double y) { top = std::max(top, y); }) &&
-                        side(
-                            [&](double t) {
-                              return Point{t * w, h};
-                            },
-                            [&](double, double y) { bottom = std::min(bottom, y); });
+  const bool inverted = side(left_edge, [&](double x, double) { left = std::max(left, x); }) &&
+                        side(right_edge, [&](double x, double) { right = std::min(right, x); }) &&
+                        side(top_edge, [&](double, double y) { top = std::max(top, y); }) &&
+                        side(bottom_edge, [&](double, double y) { bottom = std::min(bottom, y); });
   if (!inverted || !(right > left && bottom > top)) return std::nullopt;
   Intrinsics pinhole = lens;
   pinhole.fx = lens.width / (right - left);

@@ -49,8 +49,8 @@ std::string undistort_key(const std::string& source_digest, const Intrinsics& k,
 }
 
 // `k`, of the stored image, for a copy of it `width` x `height` pixels.
-Intrinsics for_copy(const Intrinsics& k, int stored_width, int width, int height) {
-  Intrinsics copy = k.scaled(static_cast<double>(width) / stored_width);
+Intrinsics for_copy(const Intrinsics& k, int width, int height) {
+  Intrinsics copy = k.scaled(static_cast<double>(width) / k.width);
   copy.width = width;
   copy.height = height;
   return copy;
@@ -86,7 +86,7 @@ Image8 ViewImages::read_source(const Camera& camera, Intrinsics& source_intrinsi
       fail_file(copy, fmt::format("image is {}x{}, expected about {} (1/{} of {})", image.width,
                                   image.height, describe(expected), scene_.downscale,
                                   describe(camera.stored)));
-    source_intrinsics = for_copy(camera.stored, camera.stored.width, image.width, image.height);
+    source_intrinsics = for_copy(camera.stored, image.width, image.height);
     return image;
   }
   Image8 image = read_image8(camera.image_path);
@@ -100,8 +100,7 @@ Image8 ViewImages::read_source(const Camera& camera, Intrinsics& source_intrinsi
 
 Image8 ViewImages::undistorted(const Camera& camera, const Image8& source,
                                const Intrinsics& source_intrinsics) const {
-  const Intrinsics pinhole =
-      for_copy(camera.pinhole, camera.stored.width, source.width, source.height);
+  const Intrinsics pinhole = for_copy(camera.pinhole, source.width, source.height);
   const fs::path cached =
       options_.undistort_cache_dir /
       (undistort_key(source_digest(camera), source_intrinsics, camera.distortion, pinhole) +
