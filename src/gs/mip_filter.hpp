@@ -27,7 +27,8 @@ inline double filter3d_std_at(double depth, double focal) {
 constexpr double kMipFilterVariance = 0.1;
 // 3DGS's screen-space dilation, in pixels^2, for models without the mip filter ("classic").
 constexpr double kClassicDilation = 0.3;
-// Floor on det(cov) / det(cov + filter), as Mip-Splatting, for numerical stability.
+// Floor on det(cov) / det(cov + filter), for numerical stability, as 3DGS's antialiasing mode
+// (Mip-Splatting's code floors each determinant instead): a needle splat keeps 0.5 % opacity.
 constexpr double kMinMipDetRatio = 0.000025;
 
 // scale: activated scales; var: effective variances s^2 + f^2; returns the opacity factor
