@@ -64,10 +64,7 @@ bool is_stale_temporary(const fs::path& path) {
 
 void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write) {
   std::error_code ec;
-  if (path.has_parent_path()) {
-    fs::create_directories(path.parent_path(), ec);
-    if (ec) fail_file(path.parent_path(), "cannot create directory: " + ec.message());
-  }
+  CreatedFolders folders(path.has_parent_path() ? path.parent_path() : fs::path("."));
   const fs::path tmp = temporary_path(path);
   const InProgress listed(tmp.string());
   try {
@@ -76,6 +73,7 @@ void write_atomically(const fs::path& path, const std::function<void(const fs::p
     if (ec) fail_file(path, "cannot move finished file into place: " + ec.message());
   } catch (...) {
     fs::remove(tmp, ec);
+    folders.remove_empty();
     throw;
   }
 }
@@ -121,6 +119,32 @@ InProgress::~InProgress() {
   if (!slot_) return;
   slot_->listed = false;
   slot_->taken = false;
+}
+
+CreatedFolders::CreatedFolders(const fs::path& folder) {
+  std::error_code ec;
+  for (fs::path missing = folder; !missing.empty() && !fs::exists(missing, ec);
+       missing = missing.parent_path())
+    created_.push_back(missing);
+  for (const fs::path& created : created_)
+    listed_.push_back(std::make_unique<InProgress>(fs::absolute(created).string(), true));
+  fs::create_directories(folder, ec);
+  if (ec) {
+    remove_empty();  // the parents made before the failure
+    fail_file(folder, "cannot create the folder (" + ec.message() + ")");
+  }
+}
+
+void CreatedFolders::remove_empty() {
+  std::error_code ec;
+  for (const fs::path& folder : created_)
+    if (!fs::remove(folder, ec)) break;  // not empty: this and every parent stay
+  forget();
+}
+
+void CreatedFolders::forget() {
+  created_.clear();
+  listed_.clear();
 }
 
 void remove_temporaries_in_progress() {

@@ -3,13 +3,15 @@
 // an interrupted run never leaves a half-written file under the final name.
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace iesrgs {
 
-// Calls write(tmp_path), then renames tmp_path to path. On any failure the temporary is removed
-// and an Error naming `path` is thrown. Creates missing parent directories.
+// Calls write(tmp_path), then renames tmp_path to path. On any failure the temporary is removed,
+// with the parent folders it created, and an Error naming `path` is thrown.
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path&)>& write);
 
@@ -43,6 +45,25 @@ class InProgress {
 
  private:
   InProgressSlot* slot_ = nullptr;
+};
+
+// Creates `folder` and its missing parents, and lists those it created for
+// remove_temporaries_in_progress while alive. Throws Error naming the folder when it cannot be
+// made.
+class CreatedFolders {
+ public:
+  explicit CreatedFolders(const std::filesystem::path& folder);
+  CreatedFolders(const CreatedFolders&) = delete;
+  CreatedFolders& operator=(const CreatedFolders&) = delete;
+
+  // Removes the created folders still empty, innermost first, and stops listing them.
+  void remove_empty();
+  // Stops listing them and leaves them: another process may be about to write there.
+  void forget();
+
+ private:
+  std::vector<std::filesystem::path> created_;  // the folder first, then its new parents
+  std::vector<std::unique_ptr<InProgress>> listed_;
 };
 
 // Removes the temporaries this process is writing now, then the listed folders left empty.

@@ -74,10 +74,7 @@ bool lock_exclusively(int fd) {
 
 FolderLock::FolderLock(const fs::path& folder) {
   refuse_inside_held_folder(folder);
-  std::error_code ec;
-  for (fs::path missing = folder; !missing.empty() && !fs::exists(missing, ec);
-       missing = missing.parent_path())
-    created_.push_back(missing);
+  created_.emplace(folder);
   try {
     take(folder);
   } catch (...) {
@@ -91,18 +88,12 @@ FolderLock::~FolderLock() {
 }
 
 void FolderLock::take(const fs::path& folder) {
-  std::error_code ec;
-  fs::create_directories(folder, ec);
-  if (ec) fail_file(folder, "cannot create the output folder (" + ec.message() + ")");
-  for (const fs::path& created : created_)
-    listed_.push_back(std::make_unique<InProgress>(fs::absolute(created).string(), true));
   // A directory can be locked itself: no lock file is left among the outputs.
   fd_ = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0)
     fail_file(folder, std::string("cannot open the output folder (") + std::strerror(errno) + ")");
   if (!lock_exclusively(fd_)) {
-    created_.clear();  // another process holds them now, and may be about to write there
-    listed_.clear();
+    created_->forget();  // another process holds them now, and may be about to write there
     fail_file(folder,
               "in use by another process (an iesrgs command, say); wait for it to end (or "
               "stop it) before writing to this folder again");
@@ -112,12 +103,9 @@ void FolderLock::take(const fs::path& folder) {
 }
 
 void FolderLock::release() {
-  // Still holding the lock (or never having got it, when created_ is empty), so that no other
+  // Still holding the lock (or never having got it, when it created nothing), so that no other
   // process starts writing in between.
-  std::error_code ec;
-  for (const fs::path& folder : created_)
-    if (!fs::remove(folder, ec)) break;  // not empty: this and every parent stay
-  listed_.clear();
+  if (created_) created_->remove_empty();
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
 }

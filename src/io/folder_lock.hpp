@@ -3,8 +3,7 @@
 // folder (a resume started while the first still runs, say) would interleave checkpoints, logs
 // and cached stages.
 #include <filesystem>
-#include <memory>
-#include <vector>
+#include <optional>
 
 #include "io/atomic_file.hpp"
 
@@ -26,12 +25,11 @@ class FolderLock {
   FolderLock& operator=(const FolderLock&) = delete;
 
  private:
-  void take(const std::filesystem::path& folder);  // creates, locks and checks the folder
+  void take(const std::filesystem::path& folder);  // locks and checks the folder
   void release();
 
   int fd_ = -1;
-  std::vector<std::filesystem::path> created_;       // the folder first, then its new parents
-  std::vector<std::unique_ptr<InProgress>> listed_;  // created_, for a signal to remove
+  std::optional<CreatedFolders> created_;
 };
 
 }  // namespace iesrgs

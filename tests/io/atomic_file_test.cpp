@@ -18,11 +18,12 @@ using testing::TempDir;
 
 namespace fs = std::filesystem;
 
-// What the signal handler removes: the temporary being written, under its own name.
+// What the signal handler removes: the temporary being written, under its own name. A write that
+// fails leaves neither it nor the folders made for it.
 TEST(AtomicFile, TheTemporaryBeingWrittenIsListedForRemoval) {
   TempDir dir;
   fs::path written;
-  EXPECT_ANY_THROW(write_atomically(dir / "out.ply", [&](const fs::path& tmp) {
+  EXPECT_ANY_THROW(write_atomically(dir / "new" / "out.ply", [&](const fs::path& tmp) {
     std::ofstream(tmp) << "half";
     written = tmp;
     remove_temporaries_in_progress();
@@ -30,6 +31,7 @@ TEST(AtomicFile, TheTemporaryBeingWrittenIsListedForRemoval) {
     throw std::runtime_error("stop");
   }));
   EXPECT_NE(written.filename().string().find("out.ply.tmp-"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "new"));
   write_file_atomically(dir / "done.json", "{}");
   remove_temporaries_in_progress();  // nothing is in progress: finished files stay
   EXPECT_TRUE(fs::exists(dir / "done.json"));
@@ -51,12 +53,12 @@ TEST(AtomicFile, AFilesOwnStaleTemporariesAreRemoved) {
 }
 
 // Ctrl-C while a file is written, outside training: the process ends as the signal ends it, and
-// neither the file nor its temporary is left.
+// neither the file, its temporary nor the folders made for it (export m new/x.ply) are left.
 TEST(AtomicFile, ASignalMidWriteLeavesNoHalfWrittenFile) {
   TempDir dir;
   EXPECT_EQ(testing::ended_by([&] {
               end_on_signals(remove_temporaries_in_progress);
-              write_atomically(dir / "model.ply", [](const fs::path& tmp) {
+              write_atomically(dir / "new" / "deeper" / "model.ply", [](const fs::path& tmp) {
                 std::ofstream(tmp) << "half";
                 std::raise(SIGINT);
               });
