@@ -97,8 +97,12 @@ void write_report(const std::filesystem::path& base, const MetricsReport& report
       {"mean", to_json(mean)}, {"views", nlohmann::json::array()}, {"lpips", report.lpips_status}};
   for (const ViewMetrics& v : report.views) json["views"].push_back(to_json(v));
   if (!report.unscored.empty()) json["unscored_views"] = report.unscored;
-  for (const char* extension : {".json", ".csv"})
+  // The earlier pair goes first: an eval stopped between its two files leaves one, not a new
+  // report beside an old one.
+  for (const char* extension : {".json", ".csv"}) {
     remove_stale_temporaries_of(base.string() + extension);  // an eval killed mid-write's
+    remove_earlier_output(base.string() + extension, "left by an earlier eval");
+  }
   write_file_atomically(base.string() + ".json", json.dump(2) + "\n");
 
   std::string csv = "name,psnr,ssim,lpips\n";

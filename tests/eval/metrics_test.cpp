@@ -1,8 +1,10 @@
 #include "eval/metrics.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -106,6 +108,20 @@ TEST(Metrics, CsvQuotesViewNamesThatNeedIt) {
   EXPECT_EQ(read_file(dir / "metrics.csv"),
             "name,psnr,ssim,lpips\n\"a,b\",20.000000,0.500000,\n"
             "\"say \"\"hi\"\"\",20.000000,0.500000,\nmean,20.000000,0.500000,\n");
+}
+
+// A report stopped between its two files (here the CSV's write fails: a folder holds its
+// temporary's name) leaves the new JSON alone, never beside the earlier CSV.
+TEST(Metrics, AReportStoppedBetweenItsFilesLeavesNoEarlierOneBeside) {
+  testing::TempDir dir;
+  MetricsReport report;
+  report.views = {{"view", 20, 0.5, std::nullopt}};
+  write_report(dir / "metrics", report);
+  report.views[0].psnr = 30;
+  std::filesystem::create_directory(dir / ("metrics.csv.tmp-" + std::to_string(::getpid())));
+  EXPECT_ANY_THROW(write_report(dir / "metrics", report));
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir / "metrics.json"))["mean"]["psnr"], 30);
+  EXPECT_FALSE(std::filesystem::exists(dir / "metrics.csv"));
 }
 
 }  // namespace
