@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "io/non_finite_records.hpp"
 
 namespace iesrgs {
 
@@ -465,23 +466,44 @@ class BinaryValues {
   const char* next_;
 };
 
+bool is_finite_float(double value) {
+  return std::fabs(value) <= FLT_MAX;
+}
+
+std::string not_finite(size_t vertex, std::string_view property, double value) {
+  return fmt::format("vertex {}: property '{}' is not a finite float ({})", vertex, property,
+                     value);
+}
+
+// Each vertex is written over the first row not yet kept, and the arrays cut to those kept.
 template <typename Values>
 void read_body(Values values, const Header& header, const std::vector<const Slot*>& targets,
                SplatCloud& cloud, const fs::path& name) {
+  NonFiniteRecords left_out(name, "Gaussian");
+  size_t kept = 0;
   for (size_t i = 0; i < header.vertex_count; ++i) {
     values.begin_vertex(i);
+    bool finite = true;
     for (size_t p = 0; p < header.properties.size(); ++p) {
       const double value = values.next(i, header.properties[p]);
       const Slot* slot = targets[p];
-      if (!slot) continue;
-      if (!(std::fabs(value) <= FLT_MAX))
-        fail_file(name, fmt::format("vertex {}: property '{}' is not a finite float ({})", i,
-                                    slot->name, value));
-      (cloud.*slot->field)[i * slot->width + slot->offset] = float(value);
+      if (!slot || !finite) continue;
+      if (!is_finite_float(value)) {
+        left_out.add([&] { return not_finite(i, slot->name, value); });
+        finite = false;
+        continue;
+      }
+      (cloud.*slot->field)[kept * slot->width + slot->offset] = float(value);
     }
     values.end_vertex(i);
+    kept += finite;
   }
   if (header.vertex_last) values.end_body(header.vertex_count);
+  left_out.report(header.vertex_count);
+  if (kept == header.vertex_count) return;
+  for (std::vector<float>* values : {&cloud.positions, &cloud.sh_dc, &cloud.sh_rest, &cloud.opacity,
+                                     &cloud.log_scales, &cloud.rotations, &cloud.filter_3d})
+    values->resize(values->size() / header.vertex_count * kept);
 }
 
 // ---- point clouds ----
@@ -515,25 +537,30 @@ template <typename Values>
 PointCloud read_points(Values values, const Header& header, const std::array<size_t, 6>& index,
                        const fs::path& name) {
   PointCloud points;
-  points.positions.resize(header.vertex_count);
-  points.colors.resize(header.vertex_count);
+  points.positions.reserve(header.vertex_count);
+  points.colors.reserve(header.vertex_count);
+  NonFiniteRecords left_out(name, "point");
   std::vector<double> row(header.properties.size());
   for (size_t i = 0; i < header.vertex_count; ++i) {
     values.begin_vertex(i);
     for (size_t p = 0; p < row.size(); ++p) row[p] = values.next(i, header.properties[p]);
     values.end_vertex(i);
-    for (size_t k = 0; k < 3; ++k)
-      if (!(std::fabs(row[index[k]]) <= FLT_MAX))
-        fail_file(name, fmt::format("vertex {}: property '{}' is not a finite float ({})", i,
-                                    kPointProperties[k], row[index[k]]));
-    points.positions[i] = {row[index[0]], row[index[1]], row[index[2]]};
+    const auto broken = std::find_if(index.begin(), index.begin() + 3,
+                                     [&](size_t p) { return !is_finite_float(row[p]); });
+    if (broken != index.begin() + 3) {
+      left_out.add(
+          [&] { return not_finite(i, kPointProperties[broken - index.begin()], row[*broken]); });
+      continue;
+    }
+    points.positions.push_back({row[index[0]], row[index[1]], row[index[2]]});
+    std::array<uint8_t, 3>& color = points.colors.emplace_back();
     for (size_t c = 0; c < 3; ++c) {
       const size_t p = index[3 + c];
-      points.colors[i][c] =
-          p == kNoProperty ? kGrey : color_byte(row[p], header.properties[p].type);
+      color[c] = p == kNoProperty ? kGrey : color_byte(row[p], header.properties[p].type);
     }
   }
   if (header.vertex_last) values.end_body(header.vertex_count);
+  left_out.report(header.vertex_count);
   return points;
 }
 

@@ -60,8 +60,9 @@ void write_ply_filter_baked(const std::filesystem::path& path, const SplatCloud&
 // unknown properties and elements after the vertex element are skipped. The SH degree follows from
 // the number of f_rest properties. A .ply has no flag for the 2D filter: the cloud is antialiased
 // when it has Mip-Splatting's filter_3D, which only its trainers write, and otherwise is drawn as
-// 3DGS and the viewers draw it (this includes write_ply_filter_baked's own output). Throws Error
-// naming the file for anything it cannot use.
+// 3DGS and the viewers draw it (this includes write_ply_filter_baked's own output). A vertex
+// holding a value that is not a finite float is left out, with a warning (NonFiniteRecords).
+// Throws Error naming the file for anything it cannot use.
 SplatCloud read_ply(const std::filesystem::path& path);
 
 // read_ply on bytes already in memory; `name` is only used in error messages.
@@ -69,8 +70,9 @@ SplatCloud parse_ply(std::string_view bytes, const std::filesystem::path& name);
 
 // The x y z and red green blue of a point cloud's vertices, as nerfstudio reads a scene's
 // ply_file_path: ascii or binary_little_endian, any scalar types, colours as bytes or, stored as
-// floats, in [0, 1], and grey where there are none. Other properties are skipped. Throws Error
-// naming the file for anything it cannot use.
+// floats, in [0, 1], and grey where there are none. Other properties are skipped, and a vertex
+// whose position is not finite is left out, with a warning. Throws Error naming the file for
+// anything it cannot use.
 PointCloud read_point_ply(const std::filesystem::path& path);
 
 // read_point_ply on bytes already in memory; `name` is only used in error messages.

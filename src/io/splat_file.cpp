@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/math.hpp"
 #include "io/atomic_file.hpp"
+#include "io/non_finite_records.hpp"
 #include "io/viewer_cloud.hpp"
 
 namespace iesrgs {
@@ -30,20 +31,23 @@ std::vector<size_t> most_visible_first(const SplatCloud& cloud) {
   return order;
 }
 
-void read_record(const char* at, size_t i, const std::filesystem::path& name, SplatCloud& cloud) {
+// Appends record i, unless a position or scale is not finite (left_out says so).
+void read_record(const char* at, size_t i, const std::filesystem::path& name, SplatCloud& cloud,
+                 NonFiniteRecords& left_out) {
   float floats[6];
   std::memcpy(floats, at, sizeof floats);
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 6; ++k)
     if (!std::isfinite(floats[k]))
-      fail_file(name, fmt::format("record {}: position {} is not finite", i, floats[k]));
-    cloud.positions.push_back(floats[k]);
-  }
+      return left_out.add([&] {
+        return fmt::format("record {}: {} {} is not finite", i, k < 3 ? "position" : "scale",
+                           floats[k]);
+      });
   for (int k = 0; k < 3; ++k) {
     const float scale = floats[3 + k];
-    if (!(scale >= 0) || !std::isfinite(scale))
-      fail_file(name, fmt::format("record {}: scale {} is not a positive number", i, scale));
+    if (scale < 0) fail_file(name, fmt::format("record {}: scale {} is negative", i, scale));
     cloud.log_scales.push_back(std::log(std::max(scale, std::numeric_limits<float>::min())));
   }
+  cloud.positions.insert(cloud.positions.end(), floats, floats + 3);
   const auto* bytes = reinterpret_cast<const uint8_t*>(at + sizeof floats);
   for (int k = 0; k < 3; ++k) cloud.sh_dc.push_back(float((bytes[k] / 255.0 - 0.5) / kShC0));
   cloud.opacity.push_back(opacity_logit_of_byte(bytes[3]));
@@ -92,8 +96,11 @@ SplatCloud parse_splat(std::string_view bytes, const std::filesystem::path& name
                                 bytes.size(), kSplatRecordBytes));
   SplatCloud cloud;
   cloud.antialiased = false;
-  for (size_t i = 0; i < bytes.size() / kSplatRecordBytes; ++i)
-    read_record(bytes.data() + i * kSplatRecordBytes, i, name, cloud);
+  NonFiniteRecords left_out(name, "Gaussian");
+  const size_t count = bytes.size() / kSplatRecordBytes;
+  for (size_t i = 0; i < count; ++i)
+    read_record(bytes.data() + i * kSplatRecordBytes, i, name, cloud, left_out);
+  left_out.report(count);
   return cloud;
 }
 

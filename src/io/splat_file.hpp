@@ -22,8 +22,9 @@ size_t write_splat(const std::filesystem::path& path, const SplatCloud& cloud);
 // A .splat file as a cloud of SH degree 0, drawn as the viewers draw it (classic 2D dilation, no
 // 3D filter). Colour and opacity come back to within their 8-bit steps and rotations to within
 // 1/128; a zero scale (a float underflow on export) becomes the smallest normal one and an
-// all-zero rotation the identity. Throws Error naming the file when its size is not a whole
-// number of records or a record holds a non-finite position or a negative or non-finite scale.
+// all-zero rotation the identity. A record whose position or scale is not finite is left out,
+// with a warning (NonFiniteRecords). Throws Error naming the file when its size is not a whole
+// number of records or a record holds a negative scale.
 SplatCloud read_splat(const std::filesystem::path& path);
 
 // read_splat on bytes already in memory; `name` is only used in error messages.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "io/atomic_file.hpp"
+#include "support/captured_log.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -246,7 +247,7 @@ TEST(Ply, PointCloudsAsOpen3dAndColmapWriteThem) {
       "1 2 1e300 0 0 0\n";
   EXPECT_NE(error_message([&] {
               parse_point_ply(infinite, "far.ply");
-            }).find("far.ply: vertex 0: property 'z' is not a finite float"),
+            }).find("far.ply: every point is left out: vertex 0: property 'z' is not a finite"),
             std::string::npos);
   EXPECT_NE(error_message([&] {
               parse_point_ply(infinite.substr(0, infinite.size() - 4), "cut");
@@ -305,9 +306,6 @@ TEST(Ply, RejectsBadInputNamingFileAndProblem) {
   write_ply(dir / "good.ply", make_cloud(1, 4, true));
   const std::string good = read_file(dir / "good.ply");
   const size_t header_size = header_of(good).size();
-  std::string infinite = good;
-  const float inf = std::numeric_limits<float>::infinity();
-  std::memcpy(&infinite[header_size + 27 * sizeof(float)], &inf, sizeof(float));
   const std::string row = "0.25 0.25 0.25 0.25 0.25 0.25 0.25 0.25 0.25 0.25 1.00 0.25 0.25 0.25\n";
   const struct {
     std::string file, bytes, problem;
@@ -326,11 +324,10 @@ TEST(Ply, RejectsBadInputNamingFileAndProblem) {
       {"rest.ply", patched(good, "f_rest_8\n", "g_rest_8\n"), "8 f_rest properties"},
       {"duplicate.ply", patched(good, "float nx\n", "float x\n"), "duplicate property 'x'"},
       {"type.ply", patched(good, "float nx\n", "half nx\n"), "unknown property type 'half'"},
-      {"infinite.ply", infinite, "vertex 1: property 'x' is not a finite float"},
       {"nan.ply", ascii_ply("1", "0 0 nan 0 0 0 0 0 0 0 1 0 0 0\n"),
-       "vertex 0: property 'z' is not a finite float"},
+       "every Gaussian is left out: vertex 0: property 'z' is not a finite float"},
       {"large.ply", ascii_ply("1", "0 0 1e39 0 0 0 0 0 0 0 1 0 0 0\n"),
-       "vertex 0: property 'z' is not a finite float"},
+       "every Gaussian is left out: vertex 0: property 'z' is not a finite float"},
       {"word.ply", ascii_ply("1", "0 zero 0 0 0 0 0 0 0 0 1 0 0 0\n"),
        "vertex 0: property 'y' has a bad number 'zero'"},
       {"short.ply", ascii_ply("2", row), "truncated: the data ends at vertex 1"},
@@ -365,6 +362,46 @@ TEST(Ply, RejectsBadInputNamingFileAndProblem) {
   }
   EXPECT_NE(error_message([&] { read_ply(dir / "absent.ply"); }).find("absent.ply: file not found"),
             std::string::npos);
+}
+
+// `cloud` without its Gaussian `index`.
+SplatCloud without(SplatCloud cloud, size_t index) {
+  const size_t count = cloud.size();
+  for (std::vector<float>* values : {&cloud.positions, &cloud.sh_dc, &cloud.sh_rest, &cloud.opacity,
+                                     &cloud.log_scales, &cloud.rotations, &cloud.filter_3d}) {
+    const size_t width = values->size() / count;
+    values->erase(values->begin() + std::ptrdiff_t(index * width),
+                  values->begin() + std::ptrdiff_t((index + 1) * width));
+  }
+  return cloud;
+}
+
+// A vertex holding a value that is not a finite float (a training diverged in part: 3DGS does not
+// check) is left out with a warning, as viewers still open such a file; the others load in order.
+TEST(Ply, VerticesHoldingNonFiniteValuesAreLeftOutWithAWarning) {
+  TempDir dir;
+  const SplatCloud cloud = make_cloud(1, 4, true);
+  write_ply(dir / "good.ply", cloud);
+  std::string bytes = read_file(dir / "good.ply");
+  const float inf = std::numeric_limits<float>::infinity();
+  // Vertex 1's x, after vertex 0's 27 floats (3 + 3 normals + 3 + 9 + 1 + 3 + 4 + 1).
+  std::memcpy(&bytes[header_of(bytes).size() + 27 * sizeof(float)], &inf, sizeof(float));
+  testing::CapturedLog log;
+  expect_same(parse_ply(bytes, "part.ply"), without(cloud, 1));
+  EXPECT_EQ(log.count("part.ply: 1 of 4 Gaussians are left out for holding a value that is not "
+                      "finite (first, vertex 1: property 'x' is not a finite float (inf))"),
+            1u)
+      << log.text();
+
+  const std::string points =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "end_header\n1 2 3 10 20 30\n4 nan 6 0 0 0\n7 8 9 40 50 60\n";
+  const PointCloud read = parse_point_ply(points, "points.ply");
+  ASSERT_EQ(read.positions.size(), 2u);
+  EXPECT_EQ(read.positions[1].x, 7);
+  EXPECT_EQ(read.colors[1], (std::array<uint8_t, 3>{40, 50, 60}));
+  EXPECT_EQ(log.count("points.ply: 1 of 3 points are left out"), 1u) << log.text();
 }
 
 TEST(Ply, WriterRejectsInconsistentOrNonFiniteClouds) {

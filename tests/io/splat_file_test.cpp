@@ -12,6 +12,7 @@
 #include "io/atomic_file.hpp"
 #include "io/model_file.hpp"
 #include "io/viewer_cloud.hpp"
+#include "support/captured_log.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -154,6 +155,22 @@ TEST(SplatFile, DegenerateRecordsAreMadeUsable) {
   EXPECT_GT(sigmoid(cloud.opacity[0]), 0.99);
 }
 
+// As a .ply's: a record that is not finite is left out, with a warning, and the others load.
+TEST(SplatFile, RecordsNotFiniteAreLeftOutWithAWarning) {
+  const Record good{{1, 2, 3}, {1, 1, 1}, {9, 9, 9, 9}, {255, 128, 128, 128}};
+  Record far = good, wide = good;
+  far.position[2] = INFINITY;
+  wide.scale[0] = NAN;
+  testing::CapturedLog log;
+  const SplatCloud cloud = parse_splat(encode(far) + encode(good) + encode(wide), "p.splat");
+  EXPECT_EQ(cloud.positions, (std::vector<float>{1, 2, 3}));
+  EXPECT_EQ(cloud.rotations.size(), 4u);
+  EXPECT_EQ(log.count("p.splat: 2 of 3 Gaussians are left out for holding a value that is not "
+                      "finite (first, record 0: position inf is not finite)"),
+            1u)
+      << log.text();
+}
+
 TEST(SplatFile, MalformedFilesAreErrorsNamingTheFile) {
   const Record good{{1, 2, 3}, {1, 1, 1}, {9, 9, 9, 9}, {255, 128, 128, 128}};
   EXPECT_TRUE(contains(error_message([] { parse_splat("", "e.splat"); }),
@@ -162,12 +179,13 @@ TEST(SplatFile, MalformedFilesAreErrorsNamingTheFile) {
                        "t.splat: is 33 bytes, not a whole number of 32-byte .splat records"));
   Record nan = good;
   nan.position[1] = NAN;
-  EXPECT_TRUE(contains(error_message([&] { parse_splat(encode(good) + encode(nan), "n.splat"); }),
-                       "n.splat: record 1: position nan is not finite"));
+  EXPECT_TRUE(
+      contains(error_message([&] { parse_splat(encode(nan), "n.splat"); }),
+               "n.splat: every Gaussian is left out: record 0: position nan is not finite"));
   Record negative = good;
   negative.scale[2] = -1;
   EXPECT_TRUE(contains(error_message([&] { parse_splat(encode(negative), "s.splat"); }),
-                       "s.splat: record 0: scale -1 is not a positive number"));
+                       "s.splat: record 0: scale -1 is negative"));
   EXPECT_TRUE(contains(error_message([&] { read_splat("/nonexistent/m.splat"); }), "m.splat"));
 }
 
