@@ -1,9 +1,11 @@
 #include "core/interrupt.hpp"
 
+#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <csignal>
+#include <cstdint>
 
 #include "core/error.hpp"
 
@@ -12,11 +14,26 @@ namespace iesrgs {
 namespace {
 
 std::atomic<int> received{0};  // the signal that asked, 0 while none did
-int open_scopes = 0;           // scopes are made by the main thread only
+std::atomic<int64_t> received_at_ns{0};
+int open_scopes = 0;  // scopes are made by the main thread only
 
 void (*exit_cleanup)() = nullptr;
 
+int64_t monotonic_ns() {  // async-signal-safe
+  timespec now{};
+  ::clock_gettime(CLOCK_MONOTONIC, &now);
+  return int64_t(now.tv_sec) * 1000000000 + now.tv_nsec;
+}
+
+// The signal that asked, sent again at once: GNU timeout signals the process and then its
+// process group, which holds it, so that its one stop arrives twice.
+bool repeats_the_request(int signal) {
+  return signal == received.load() &&
+         monotonic_ns() - received_at_ns.load() < int64_t(kRepeatedSignalMs) * 1000000;
+}
+
 extern "C" void end_now(int signal) {
+  if (repeats_the_request(signal)) return;
   if (exit_cleanup) exit_cleanup();
   static constexpr char kMessage[] =
       "\ninterrupted: stopped before the end; the files being written were removed\n";
@@ -35,6 +52,7 @@ void (*catch_signal(int signal, void (*handler)(int)))(int) {
 }
 
 extern "C" void request_interrupt(int signal) {
+  received_at_ns = monotonic_ns();
   received = signal;
   std::signal(signal, end_now);  // a second Ctrl-C stops at once
 }

@@ -1,10 +1,14 @@
 #pragma once
 // SIGINT (Ctrl-C) and SIGTERM (kill, timeout, docker stop) ask long work to stop at its next safe
 // point, while an InterruptScope is alive; outside one they end the process as the signal does
-// (after end_on_signals' cleanup, once it is set). A second signal ends it at once.
+// (after end_on_signals' cleanup, once it is set). A second signal ends it at once, unless it is
+// the first one again within kRepeatedSignalMs (timeout sends its one stop twice).
 #include <string>
 
 namespace iesrgs {
+
+// How long the signal that asked to stop counts as the same request when it comes again.
+constexpr int kRepeatedSignalMs = 250;
 
 // Catches the two signals for its lifetime. Scopes nest: an inner one keeps a request the outer
 // one received, and each gives the handlers back as it found them.

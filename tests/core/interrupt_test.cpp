@@ -2,11 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <thread>
 
 #include "core/error.hpp"
 #include "support/ended_by.hpp"
@@ -18,6 +20,11 @@ namespace {
 
 using testing::ended_by;
 using testing::error_message;
+
+// Past the time within which the signal that asked counts as the same request again.
+void wait_past_repeats() {
+  std::this_thread::sleep_for(std::chrono::milliseconds(kRepeatedSignalMs + 50));
+}
 
 TEST(Interrupt, ASignalInsideAScopeAsksTheWorkToStop) {
   const InterruptScope scope;
@@ -48,15 +55,25 @@ TEST(Interrupt, EndOnSignalsEndsTheProcessAfterTheCleanup) {
               signal);
     return !std::filesystem::exists(marker);
   };
+  wait_past_repeats();  // an earlier test's request, which a signal now would repeat
   EXPECT_TRUE(cleaned_up([] { std::raise(SIGTERM); }, SIGTERM));
   EXPECT_TRUE(cleaned_up(
       [] {
         const InterruptScope scope;
         std::raise(SIGTERM);  // asks
         if (!interrupt_requested()) ::_exit(3);
+        wait_past_repeats();
         std::raise(SIGTERM);  // ends
       },
       SIGTERM));
+  // The same stop sent again at once (as timeout sends it) is the same request: work goes on.
+  EXPECT_FALSE(cleaned_up(
+      [] {
+        const InterruptScope scope;
+        std::raise(SIGTERM);
+        std::raise(SIGTERM);
+      },
+      0));
   EXPECT_TRUE(cleaned_up(
       [] {
         const InterruptScope outer;
@@ -64,6 +81,7 @@ TEST(Interrupt, EndOnSignalsEndsTheProcessAfterTheCleanup) {
           const InterruptScope inner;
           std::raise(SIGINT);
         }
+        wait_past_repeats();
         std::raise(SIGINT);  // the second, after the inner scope gave its handler back
       },
       SIGINT));
@@ -88,6 +106,7 @@ TEST(Interrupt, AnInnerScopeKeepsTheOuterScopesRequest) {
     EXPECT_EQ(interrupt_exit_status(), 128 + SIGINT);
   }
   // A second signal would now end the process, not be caught by the outer scope's handler.
+  wait_past_repeats();
   EXPECT_EQ(ended_by([] { std::raise(SIGINT); }), SIGINT);
   outer.reset();
   const InterruptScope next;  // a new outermost scope starts afresh
