@@ -1,10 +1,13 @@
 // iesrgs: low-resolution multi-view captures in, high-resolution 3D Gaussian Splatting out.
 #include <fmt/core.h>
+#include <fmt/format.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
 
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "core/device.hpp"
@@ -12,6 +15,29 @@
 #include "core/interrupt.hpp"
 #include "core/torch_error.hpp"
 #include "io/atomic_file.hpp"
+
+namespace {
+
+// An option error in the form of every other error. CLI11 answers a misspelled command with "A
+// subcommand is required" alone: the word it did not know and the commands it knows are named.
+std::string option_error(const CLI::App* app, const CLI::Error& error) {
+  const CLI::App* command = app;
+  while (!command->get_subcommands().empty()) command = command->get_subcommands().back();
+  const std::vector<std::string> unknown = command->remaining();
+  if (error.get_name() != "RequiredError" || command->get_require_subcommand_min() == 0 ||
+      command->get_subcommands().size() >= command->get_require_subcommand_min())
+    return fmt::format("error: {} (--help lists the options)\n", error.what());
+  std::vector<std::string> known;
+  for (const CLI::App* sub : command->get_subcommands([](const CLI::App*) { return true; }))
+    known.push_back(sub->get_name());
+  const std::string what = command == app ? "command" : command->get_name() + " mode";
+  return fmt::format("error: {} (known: {})\n",
+                     unknown.empty() ? fmt::format("no {} given", what)
+                                     : fmt::format("unknown {} '{}'", what, unknown.front()),
+                     fmt::join(known, ", "));
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   // Progress reaches a pipe or a log as each line is printed, and a killed command keeps it.
@@ -23,11 +49,8 @@ int main(int argc, char** argv) {
   // uses for our own kernels (OMP_NUM_THREADS still limits both).
   torch::set_num_threads(omp_get_max_threads());
   app.require_subcommand(1);
-  // Option errors in the form of every other error (CLI11's exit codes stay); set before the
-  // subcommands are added, which copy it.
-  app.failure_message([](const CLI::App*, const CLI::Error& e) {
-    return fmt::format("error: {} (--help lists the options)\n", e.what());
-  });
+  // CLI11's exit codes stay; set before the subcommands are added, which copy it.
+  app.failure_message(option_error);
   // Which device --device auto takes here, so a user sees at once whether the GPU is usable.
   app.set_version_flag("--version", [] {
     return fmt::format("iesrgs " IESRGS_VERSION "\nCUDA kernels: {}\n--device auto: {}",

@@ -72,6 +72,18 @@ TEST(Cli, VersionSaysWhichDeviceAutoTakes) {
   EXPECT_TRUE(contains(run.output, "--device auto: ")) << run.output;
 }
 
+// CLI11 alone says "A subcommand is required" to a misspelled command.
+TEST(Cli, AnUnknownCommandIsNamedWithTheKnownOnes) {
+  const CliRun command = iesrgs("tran scene -o out");
+  EXPECT_NE(command.status, 0);
+  EXPECT_TRUE(contains(last_line(command.output), "error: unknown command 'tran' (known: synth, "))
+      << command.output;
+  EXPECT_TRUE(contains(last_line(command.output), " train, ")) << command.output;
+  EXPECT_EQ(last_line(iesrgs("bench rastr").output),
+            "error: unknown bench mode 'rastr' (known: raster, ssim, adam)");
+  EXPECT_TRUE(contains(last_line(iesrgs("").output), "error: no command given (known: "));
+}
+
 TEST(Cli, MissingSceneIsOneLineNamingThePath) {
   TempDir dir;
   const CliRun run = iesrgs("info " + (dir / "nowhere").string());
