@@ -40,7 +40,9 @@ struct EvalArgs {
 // is read from there.
 std::vector<std::filesystem::path> render_files(std::filesystem::path dir) {
   if (std::filesystem::is_directory(dir / "rgb")) dir /= "rgb";
-  if (!std::filesystem::is_directory(dir)) fail_file(dir, "is not a folder of rendered images");
+  std::error_code ec;
+  if (!std::filesystem::exists(dir, ec)) fail_file(dir, "renders not found");
+  if (!std::filesystem::is_directory(dir, ec)) fail_file(dir, "is not a folder of rendered images");
   std::vector<std::filesystem::path> files = image_files_in(dir);
   // a.png and a.jpg would both be scored as view a, which would count twice in the mean.
   if (const auto shared = first_shared_stem(files))

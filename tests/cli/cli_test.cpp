@@ -396,6 +396,9 @@ TEST(Cli, EvalWritesNoReportOverItsInputs) {
   EXPECT_TRUE(contains(last_line(over_record.output), "would replace the renders' render.json"))
       << over_record.output;
   EXPECT_EQ(iesrgs("eval --lpips none " + renders + " " + scene).status, 0);  // metrics.json
+  const std::string nowhere = (dir / "nowhere").string();
+  EXPECT_EQ(last_line(iesrgs("eval --lpips none " + nowhere + " " + scene).output),
+            "error: " + nowhere + ": renders not found");
 }
 
 TEST(Cli, EvalOfPartOfASplitNamesTheViewsLeftOut) {

@@ -472,7 +472,11 @@ std::unique_ptr<SrNet> swinir_sr(SwinIR net) {
 }
 
 std::unique_ptr<SrNet> make_swinir(const std::filesystem::path& weights, int scale) {
-  if (weights.empty()) fail("swinir: no checkpoint file given");
+  if (weights.empty())
+    fail(
+        "swinir: no checkpoint file given: pass the authors' .pth, e.g. "
+        "001_classicalSR_DF2K_s64w8_SwinIR-M_x4.pth, with --weights (upscale) or --sr-weights "
+        "(run, external)");
   StateDict state = read_state_dict(weights);
   const SwinIRConfig config = infer_swinir_config(state, weights);
   if (config.scale != scale)
