@@ -121,13 +121,14 @@ void write_results(const std::filesystem::path& dir, const RunResult& result) {
   nlohmann::json json = {{"stages", result.stages},
                          {"evaluation", result.evaluation},
                          {"rows", nlohmann::json::array()}};
-  std::string csv = "row,label,psnr,ssim,lpips,train_seconds,fps\n";
+  std::string csv = "row,label,psnr,ssim,lpips,train_seconds,fps,from_earlier_run\n";
   for (const RowResult& row : result.rows) {
     json["rows"].push_back(row_json(row));
-    csv += fmt::format("{},\"{}\",{},{},{},{},{}\n", row.id, row.label,
-                       format_metric(row, row.mean.psnr, 4), format_metric(row, row.mean.ssim, 5),
-                       row.mean.lpips ? fmt::format("{:.5f}", *row.mean.lpips) : "",
-                       row.train_seconds, row.fps > 0 ? fmt::format("{}", row.fps) : "");
+    csv +=
+        fmt::format("{},\"{}\",{},{},{},{},{},{}\n", row.id, row.label,
+                    format_metric(row, row.mean.psnr, 4), format_metric(row, row.mean.ssim, 5),
+                    row.mean.lpips ? fmt::format("{:.5f}", *row.mean.lpips) : "", row.train_seconds,
+                    row.fps > 0 ? fmt::format("{}", row.fps) : "", row.from_earlier_run);
   }
   write_file_atomically(dir / "results.json", json.dump(2) + "\n");
   write_file_atomically(dir / "results.csv", csv);

@@ -29,7 +29,9 @@ RunResult sample_result() {
 
 TEST(Results, WrittenRowsReadBackAsEarlierRows) {
   testing::TempDir dir;
-  write_results(dir.path(), sample_result());
+  RunResult result = sample_result();
+  result.rows[0].from_earlier_run = true;
+  write_results(dir.path(), result);
   const nlohmann::json json = nlohmann::json::parse(read_file(dir / "results.json"));
   EXPECT_EQ(json["evaluation"]["test_views"], "digest");
   const RowResult back = earlier_row(*find_row("ie-srgs"), "IE-SRGS", json["rows"][1]);
@@ -45,9 +47,9 @@ TEST(Results, WrittenRowsReadBackAsEarlierRows) {
   EXPECT_FALSE(unscored.evaluated);
   EXPECT_FALSE(unscored.mean.lpips.has_value());
   EXPECT_EQ(read_file(dir / "results.csv"),
-            "row,label,psnr,ssim,lpips,train_seconds,fps\n"
-            "internal,\"internal only\",-,-,,103,290.9\n"
-            "ie-srgs,\"IE-SRGS\",26.6800,0.93500,0.10000,12,400\n");
+            "row,label,psnr,ssim,lpips,train_seconds,fps,from_earlier_run\n"
+            "internal,\"internal only\",-,-,,103,290.9,true\n"
+            "ie-srgs,\"IE-SRGS\",26.6800,0.93500,0.10000,12,400,false\n");
 }
 
 TEST(Results, MarkdownMarksEarlierRowsShowsDashesWithoutTruthAndTimesTheStages) {
