@@ -97,18 +97,17 @@ void write_report(const std::filesystem::path& base, const MetricsReport& report
       {"mean", to_json(mean)}, {"views", nlohmann::json::array()}, {"lpips", report.lpips_status}};
   for (const ViewMetrics& v : report.views) json["views"].push_back(to_json(v));
   if (!report.unscored.empty()) json["unscored_views"] = report.unscored;
-  // The earlier pair goes first: an eval stopped between its two files leaves one, not a new
-  // report beside an old one.
+  // The earlier pair goes first: an eval stopped as it renames its two files leaves one, not a
+  // new report beside an old one.
   for (const char* extension : {".json", ".csv"}) {
     remove_stale_temporaries_of(base.string() + extension);  // an eval killed mid-write's
     remove_earlier_output(base.string() + extension, "left by an earlier eval");
   }
-  write_file_atomically(base.string() + ".json", json.dump(2) + "\n");
-
   std::string csv = "name,psnr,ssim,lpips\n";
   for (const ViewMetrics& v : report.views) csv += csv_row(v);
   csv += csv_row(mean);
-  write_file_atomically(base.string() + ".csv", csv);
+  write_files_atomically(
+      {{base.string() + ".json", json.dump(2) + "\n"}, {base.string() + ".csv", csv}});
 }
 
 }  // namespace iesrgs::eval

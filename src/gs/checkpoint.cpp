@@ -78,8 +78,7 @@ void save_training_state(const std::filesystem::path& path, const GaussianModel&
       out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
       return size;
     });
-    out.close();
-    if (!out) fail_file(path, "write failed (disk full or not writable?)");
+    close_written(out, path);
   });
 }
 

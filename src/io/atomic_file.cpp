@@ -68,6 +68,7 @@ void write_atomically(const fs::path& path, const std::function<void(const fs::p
   const fs::path tmp = temporary_path(path);
   const InProgress listed(tmp.string());
   try {
+    errno = 0;  // for close_written
     write(tmp);
     fs::rename(tmp, path, ec);
     if (ec) fail_file(path, "cannot move finished file into place: " + ec.message());
@@ -159,17 +160,47 @@ void remove_temporaries_in_progress() {
   }
 }
 
-void write_file_atomically(const fs::path& path, const std::string& bytes) {
+namespace {
+
+// Each file's temporary is written inside the previous one's write, so that the renames come
+// last, the last file's first.
+void write_files_from(const std::vector<std::pair<fs::path, std::string>>& files, size_t first) {
+  if (first == files.size()) return;
+  const auto& [path, bytes] = files[first];
   write_atomically(path, [&](const fs::path& tmp) {
     std::ofstream out(tmp, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) fail_file(path, "write failed (disk full or not writable?)");
+    close_written(out, path);
+    write_files_from(files, first + 1);
   });
+}
+
+}  // namespace
+
+void write_file_atomically(const fs::path& path, const std::string& bytes) {
+  write_files_from({{path, bytes}}, 0);
+}
+
+void write_files_atomically(const std::vector<std::pair<fs::path, std::string>>& files) {
+  write_files_from(files, 0);
+}
+
+std::string write_failure(int error) {
+  return error ? fmt::format("write failed: {}", std::strerror(error))
+               : "write failed (disk full or not writable?)";
+}
+
+void close_written(std::ofstream& out, const fs::path& path) {
+  if (out) errno = 0;  // else the failed write's, as a stream makes no calls once it has failed
+  out.close();
+  if (!out) fail_file(path, write_failure(errno));
 }
 
 bool remove_earlier_output(const fs::path& file, std::string_view left_by) {
   std::error_code ec;
+  // Not there, or its folder not a folder: nothing to remove, and the output's write will say
+  // what stands in its way (a read-only disk answers even an absent file's removal with EROFS).
+  if (!fs::exists(fs::symlink_status(file, ec))) return false;
   const bool removed = fs::remove(file, ec);
   if (ec) fail_file(file, fmt::format("{}, and cannot be removed: {}", left_by, ec.message()));
   return removed;

@@ -3,9 +3,11 @@
 // an interrupted run never leaves a half-written file under the final name.
 #include <filesystem>
 #include <functional>
+#include <iosfwd>
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace iesrgs {
@@ -17,6 +19,19 @@ void write_atomically(const std::filesystem::path& path,
 
 // Atomic text / binary file writes.
 void write_file_atomically(const std::filesystem::path& path, const std::string& bytes);
+
+// Files that belong together (a report's .json and .csv), written as write_file_atomically
+// writes one: all of them complete before the first is renamed into place, so that a failure (a
+// full disk) leaves none of them.
+void write_files_atomically(
+    const std::vector<std::pair<std::filesystem::path, std::string>>& files);
+
+// "write failed: <the system's reason>" for an errno a failed write left, or a guess without one.
+std::string write_failure(int error);
+
+// Closes `out`, written for `path` (inside write_atomically, which clears errno first); throws
+// Error naming `path`, with the system's reason, when any write to it failed.
+void close_written(std::ofstream& out, const std::filesystem::path& path);
 
 // Levels of subfolders an output folder's own outputs reach: a run's rows/<row>/test/rgb/.
 constexpr int kOutputFolderDepth = 4;

@@ -572,8 +572,7 @@ void write_ply(const fs::path& path, const SplatCloud& cloud) {
     std::ofstream out(tmp, std::ios::binary);
     out << header_text(cloud, slots);
     write_body(out, cloud, slots, path);
-    out.close();
-    if (!out) fail_file(path, "write failed (disk full or not writable?)");
+    close_written(out, path);
   });
 }
 

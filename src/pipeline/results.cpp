@@ -130,9 +130,9 @@ void write_results(const std::filesystem::path& dir, const RunResult& result) {
                     row.mean.lpips ? fmt::format("{:.5f}", *row.mean.lpips) : "", row.train_seconds,
                     row.fps > 0 ? fmt::format("{}", row.fps) : "", row.from_earlier_run);
   }
-  write_file_atomically(dir / "results.json", json.dump(2) + "\n");
-  write_file_atomically(dir / "results.csv", csv);
-  write_file_atomically(dir / "results.md", results_markdown(result));
+  write_files_atomically({{dir / "results.json", json.dump(2) + "\n"},
+                          {dir / "results.csv", csv},
+                          {dir / "results.md", results_markdown(result)}});
 }
 
 }  // namespace iesrgs::pipeline

@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <fstream>
 
@@ -36,7 +37,8 @@ std::string log_until(const std::filesystem::path& csv, int64_t last_iteration) 
 
 ProgressLog::ProgressLog(const std::filesystem::path& csv, int64_t first_iteration,
                          int64_t total_iterations, int64_t log_every, double seconds_before)
-    : first_iteration_(first_iteration),
+    : path_(csv),
+      first_iteration_(first_iteration),
       total_iterations_(total_iterations),
       log_every_(log_every),
       seconds_before_(seconds_before),
@@ -48,7 +50,13 @@ ProgressLog::ProgressLog(const std::filesystem::path& csv, int64_t first_iterati
 }
 
 void ProgressLog::flush() {
+  errno = 0;
   csv_.flush();
+  require_written();
+}
+
+void ProgressLog::require_written() const {
+  if (!csv_) fail_file(path_, write_failure(errno));
 }
 
 void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
@@ -58,14 +66,16 @@ void ProgressLog::record(int64_t iteration, double loss, int64_t gaussians,
                        : kLossSmoothing * smoothed_loss_ + (1 - kLossSmoothing) * loss;
   const double elapsed = run_.seconds();
   if (force || test_psnr || iteration % log_every_ == 0) {
+    errno = 0;
     csv_ << iteration << ',' << loss << ',' << gaussians << ',' << seconds_before_ + elapsed << ',';
     if (test_psnr) csv_ << *test_psnr;
     csv_ << '\n';
+    require_written();
   }
   const double since_print = since_print_.seconds();
   if (!force && !test_psnr && since_print < kPrintSeconds) return;
   since_print_.restart();
-  csv_.flush();
+  flush();
   const double rate = since_print > 0 ? double(iteration - last_print_iteration_) / since_print : 0;
   std::string line = fmt::format(
       "[{:>{}}/{}] {:5.1f}% | {:6.2f} it/s | loss {:.4f} | {:>8} Gaussians | elapsed {} | ETA {}",

@@ -28,6 +28,11 @@ class ProgressLog {
   void flush();
 
  private:
+  // A row a full disk refused would reach the file later, in part or twice, among later rows:
+  // training stops instead (its checkpoint stays, and --resume cuts the log back to it).
+  void require_written() const;
+
+  std::filesystem::path path_;
   std::ofstream csv_;
   int64_t first_iteration_, total_iterations_, log_every_;
   double seconds_before_;

@@ -9,6 +9,8 @@
 
 #include "core/interrupt.hpp"
 #include "support/ended_by.hpp"
+#include "support/expect_error.hpp"
+#include "support/file_size_limit.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs {
@@ -35,6 +37,52 @@ TEST(AtomicFile, TheTemporaryBeingWrittenIsListedForRemoval) {
   write_file_atomically(dir / "done.json", "{}");
   remove_temporaries_in_progress();  // nothing is in progress: finished files stay
   EXPECT_TRUE(fs::exists(dir / "done.json"));
+}
+
+// 0 when 8 KB written to `file` past a 4 KB limit fail naming it, as the system names the cause.
+int write_past_the_limit(const fs::path& file) {
+  const std::string message =
+      testing::error_message([&] { write_file_atomically(file, std::string(8192, 'x')); });
+  return testing::contains(message, file.string() + ": write failed: File too large") ? 0 : 1;
+}
+
+// A full disk is named as the system names it, and leaves no temporary.
+TEST(AtomicFile, AFullDiskIsNamedAndLeavesNoTemporary) {
+  TempDir dir;
+  EXPECT_EQ(testing::exit_status_with_file_size_limit(
+                4096, [&] { return write_past_the_limit(dir / "big.json"); }),
+            0);
+  EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+// Files that belong together are all written, or (here the second's temporary cannot be made)
+// none of them.
+TEST(AtomicFile, FilesThatBelongTogetherAreWrittenAllOrNone) {
+  TempDir dir;
+  const std::vector<std::pair<fs::path, std::string>> files = {
+      {dir / "a.json", "a"}, {dir / "b.csv", "b"}, {dir / "c.md", "c"}};
+  fs::create_directories(dir / ("b.csv.tmp-" + std::to_string(::getpid())) / "in-the-way");
+  EXPECT_ANY_THROW(write_files_atomically(files));
+  for (const auto& [path, bytes] : files) EXPECT_FALSE(fs::exists(path)) << path;
+  fs::remove_all(dir / ("b.csv.tmp-" + std::to_string(::getpid())));
+  write_files_atomically(files);
+  for (const auto& [path, bytes] : files) EXPECT_EQ(read_file(path), bytes);
+}
+
+// An earlier output that is not there is not blamed for what stands in the new one's way.
+TEST(AtomicFile, AnEarlierOutputNotThereIsNotRemoved) {
+  TempDir dir;
+  std::ofstream(dir / "file") << "x";
+  EXPECT_FALSE(remove_earlier_output(dir / "file" / "m.json", "left by an earlier eval"));
+  EXPECT_FALSE(remove_earlier_output(dir / "absent.json", "left by an earlier eval"));
+  EXPECT_TRUE(remove_earlier_output(dir / "file", "left by an earlier eval"));
+  const std::string message = testing::error_message([&] {
+    write_file_atomically(dir / "new" / "m.json", "{}");
+    std::ofstream(dir / "blocker") << "x";
+    write_file_atomically(dir / "blocker" / "m.json", "{}");
+  });
+  EXPECT_TRUE(testing::contains(message, (dir / "blocker").string() + ": cannot create the folder"))
+      << message;
 }
 
 // Beside a file written into any folder (export's, eval's), only that file's temporaries that a

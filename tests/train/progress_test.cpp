@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "support/expect_error.hpp"
+#include "support/file_size_limit.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs::train {
@@ -55,6 +58,27 @@ TEST(TrainProgress, LogsEveryLogEveryIterations) {
   std::vector<int> iterations;
   for (const std::string& row : lines_of(csv)) iterations.push_back(std::atoi(row.c_str()));
   EXPECT_EQ(iterations, (std::vector<int>{0, 5, 7, 10, 12}));  // the header reads as 0
+}
+
+// Logs rows until the disk refuses one: 0 when that stops the training naming the log, 2 for
+// another error, 3 for none.
+int log_until_the_disk_is_full(const std::filesystem::path& csv) {
+  try {
+    ProgressLog log(csv, 0, 100000, 1, 0.0);
+    for (int64_t i = 1; i <= 100000; ++i) log.record(i, 0.5, 10, std::nullopt, false);
+  } catch (const Error& e) {
+    return testing::contains(e.what(), csv.string() + ": write failed: File too large") ? 0 : 2;
+  }
+  return 3;
+}
+
+// A row the disk refuses would reach the file later, in part or twice: the training stops there.
+TEST(TrainProgress, ARowTheDiskRefusesStopsTheTraining) {
+  testing::TempDir dir;
+  const auto csv = dir / "train_log.csv";
+  EXPECT_EQ(testing::exit_status_with_file_size_limit(
+                4096, [&] { return log_until_the_disk_is_full(csv); }),
+            0);
 }
 
 }  // namespace
