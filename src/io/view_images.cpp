@@ -120,7 +120,11 @@ Image8 ViewImages::undistorted(const Camera& camera, const Image8& source,
   try {
     write_png(cached, image);
   } catch (const Error& e) {
-    spdlog::warn("cannot cache the undistorted image ({}); continuing without the cache", e.what());
+    if (!cache_failed_.exchange(true))
+      spdlog::warn(
+          "cannot cache undistorted images ({}); continuing without the cache, so each run "
+          "undistorts them again (IESRGS_CACHE_DIR sets where it is)",
+          e.what());
   }
   return image;
 }

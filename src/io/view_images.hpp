@@ -2,6 +2,7 @@
 // Lazy, bounded-memory access to a scene's images at the cameras' resolution. Nothing is decoded
 // until asked for, and at most `cache_bytes` of decoded images stay in memory (least recently
 // used first out), so a capture of thousands of images never has to fit in RAM at once.
+#include <atomic>
 #include <cstddef>
 #include <filesystem>
 #include <list>
@@ -58,6 +59,7 @@ class ViewImages {
   size_t cached_bytes_ = 0;
   mutable std::mutex digest_mutex_;
   mutable std::unordered_map<std::string, std::string> digests_;  // by source path
+  mutable std::atomic<bool> cache_failed_{false};  // said once: the cause is every image's
 };
 
 }  // namespace iesrgs

@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "io/atomic_file.hpp"
 #include "io/view_images.hpp"
+#include "support/captured_log.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -149,6 +152,21 @@ TEST(ViewImages, UndistortsOnceIntoTheCache) {
     cached += entry.path().extension() == ".png";
   EXPECT_EQ(cached, 1);
   EXPECT_EQ(images.read8(camera).data, first.data);
+}
+
+// A cache that cannot be written (here a file holds its folder's name) leaves the images
+// undistorted all the same, and says so once, not once per image.
+TEST(ViewImages, ACacheThatCannotBeWrittenIsSaidOnce) {
+  SceneFixture f;
+  std::ofstream(f.dir / "taken") << "x";
+  f.options.undistort_cache_dir = f.dir / "taken" / "undistorted";
+  Camera a = f.add("a.png", solid(16, 12, {9, 99, 199}));
+  Camera b = f.add("b.png", solid(16, 12, {9, 99, 199}));
+  a.distortion = b.distortion = {0.05, 0, 0, 0};
+  testing::CapturedLog log;
+  ViewImages images(f.scene, f.options);
+  EXPECT_EQ(images.read8(a).data, images.read8(b).data);
+  EXPECT_EQ(log.count("cannot cache undistorted images"), 1u) << log.text();
 }
 
 // The cache entry is named by the source's content: a copy with a new time reuses it, an edited
