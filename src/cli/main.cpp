@@ -87,5 +87,13 @@ int main(int argc, char** argv) {
   } catch (...) {
     return report(iesrgs::current_exception_message().c_str());
   }
+  // A stop asked for as the last outputs were written (training's final checkpoint, a run's
+  // table): they are complete, and the status says the signal came, so a script stops here too
+  // (bash goes on after a command that exits 0).
+  if (iesrgs::interrupt_requested()) {
+    std::fprintf(stderr,
+                 "interrupted: after the command had done its work; its outputs are whole\n");
+    return iesrgs::interrupt_exit_status();
+  }
   return 0;
 }
