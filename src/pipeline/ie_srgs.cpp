@@ -272,6 +272,15 @@ void Pipeline::forget_earlier_results() const {
   if (internal_changes) forget_row("internal");
   if (scoring)
     for (const std::string& id : rows_) forget_row(id);
+  // Written whole again after the ie-srgs row; a stopped run would leave an earlier run's
+  // pictures, of other settings, or some of each.
+  if (scoring && std::find(rows_.begin(), rows_.end(), "ie-srgs") != rows_.end()) {
+    std::error_code ec;
+    fs::remove_all(o_.output / "diagnostics", ec);
+    if (ec)
+      fail_file(o_.output / "diagnostics",
+                "left by an earlier run, and cannot be removed: " + ec.message());
+  }
 }
 
 // The stages' time is what computing their views took when it ran, as a reused training counts

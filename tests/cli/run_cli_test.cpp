@@ -310,6 +310,13 @@ TEST_F(RunCli, AStoppedRerunLeavesNothingOfTheEarlierRunThatReadsAsItsOwn) {
     EXPECT_FALSE(std::filesystem::exists(run / "rows" / row / "test" / "metrics.json")) << row;
   }
   EXPECT_TRUE(contains(iesrgs("info " + out).output, "no results.md yet"));
+  // The diagnostics, which the ie-srgs row writes again, go too.
+  testing::write_text(run / "diagnostics" / "r_9" / "mask.png", "of an earlier run");
+  ASSERT_EQ(iesrgs("run " + scene + " -o " + out +
+                   " --rows internal,ie-srgs --sr-model swinir --lpips none")
+                .status,
+            1);
+  EXPECT_FALSE(std::filesystem::exists(run / "diagnostics"));
 
   // The earlier command again writes them back from its cached stages; other settings retrain.
   ASSERT_EQ(run_rows("internal,external").status, 0);
