@@ -65,8 +65,9 @@ train::TrainConfig requested_config(const TrainArgs& args,
 }
 
 // The stored config is the run's identity: --resume continues with it. Options given beside it
-// must make the same config (the run's own command again), or none be given. Without --preset
-// they apply to the stored config, so that the refusal names only what they change.
+// must make the same config (the run's own command again) but for its reporting fields
+// (train::kReportingFields), which they may change, or none be given. Without --preset they apply
+// to the stored config, so that the refusal names only what they change.
 train::TrainConfig resumed_config(const TrainArgs& args, const std::filesystem::path& saved) {
   if (!std::filesystem::exists(saved))
     fail_file(saved, "missing: --resume needs the output folder of an earlier run");
@@ -79,14 +80,14 @@ train::TrainConfig resumed_config(const TrainArgs& args, const std::filesystem::
   }
   spdlog::info("resuming with the config saved in {}", saved.string());
   if (!args.run_options_given) return config;
-  const std::vector<std::string> changes =
-      train::config_changes(config, requested_config(args, config));
+  const train::TrainConfig requested = requested_config(args, config);
+  const std::vector<std::string> changes = train::config_changes(config, requested);
   if (!changes.empty())
     fail_file(saved, fmt::format(
                          "--resume continues this run, and the options given would change it ({}); "
                          "give the run's own options or none, or train into a new folder",
                          fmt::join(changes, ", ")));
-  return config;
+  return requested;
 }
 
 void run_train(const TrainArgs& args) {
@@ -115,12 +116,11 @@ void run_train(const TrainArgs& args) {
     fmt::print("resuming {} from {}\n", trainer.resume_point(), trainer.checkpoint_path().string());
   // Only now that the scene and the starting model have loaded: a folder holding a config but no
   // checkpoint would make --resume fail on that instead of the real problem.
-  if (!args.resume) {
-    if (train::remove_earlier_run(out))
-      spdlog::warn("{}: replaced the earlier run there (--resume continues a run instead)",
-                   out.string());
-    write_file_atomically(out / "config.json", train::to_json(config).dump(2) + "\n");
-  }
+  if (!args.resume && train::remove_earlier_run(out))
+    spdlog::warn("{}: replaced the earlier run there (--resume continues a run instead)",
+                 out.string());
+  // Again on --resume: it may report and checkpoint otherwise.
+  write_file_atomically(out / "config.json", train::to_json(config).dump(2) + "\n");
   const train::TrainSummary summary = trainer.run();
   if (summary.interrupted) throw Interrupted("continue with the same command and --resume");
   train::write_point_clouds(out, trainer);

@@ -18,10 +18,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// What a training stage's record must match: its inputs and its whole training config.
-nlohmann::json training_stage_identity(const nlohmann::json& params,
+// What a training stage's record must match: its inputs and its whole training config. A record
+// that differs only in the reporting fields (train::kReportingFields) is this stage's: they leave
+// the model as it is, so it is reused, or resumed reporting as now asked.
+nlohmann::json training_stage_identity(const fs::path& dir, const nlohmann::json& params,
                                        const train::TrainConfig& config) {
-  return {{"stage", params}, {"training", train::to_json(config)}};
+  const nlohmann::json identity = {{"stage", params}, {"training", train::to_json(config)}};
+  const nlohmann::json recorded =
+      read_stage_record(dir / "stage.json").value("params", nlohmann::json());
+  if (!recorded.is_object() || !recorded.value("training", nlohmann::json()).is_object())
+    return identity;
+  nlohmann::json same = identity;
+  for (const char* key : train::kReportingFields)
+    if (recorded["training"].contains(key)) same["training"][key] = recorded["training"][key];
+  return same == recorded ? same : identity;
 }
 
 // A finished stage whose model was deleted (say, because it was damaged) trains again.
@@ -35,7 +45,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
                                const train::TrainConfig& config, train::TrainerSetup setup,
                                const std::function<gs::GaussianModel()>& initial_model) {
   const fs::path dir = setup.output_dir;
-  const nlohmann::json identity = training_stage_identity(params, config);
+  const nlohmann::json identity = training_stage_identity(dir, params, config);
   // The recorded time of a finished stage whose model is made again from its final checkpoint:
   // the later stages that learnt from the model are keyed on it.
   std::optional<double> finished_seconds;
@@ -91,7 +101,7 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
 
 bool training_stage_current(const fs::path& dir, const nlohmann::json& params,
                             const train::TrainConfig& config) {
-  return model_finished(dir, training_stage_identity(params, config));
+  return model_finished(dir, training_stage_identity(dir, params, config));
 }
 
 }  // namespace iesrgs::pipeline

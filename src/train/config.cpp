@@ -132,7 +132,9 @@ std::vector<std::string> config_changes(const TrainConfig& from, const TrainConf
   const nlohmann::json before = to_json(from), after = to_json(to);
   std::vector<std::string> changes;
   for (const auto& item : before.items())
-    if (after[item.key()] != item.value())
+    if (after[item.key()] != item.value() &&
+        std::find(kReportingFields.begin(), kReportingFields.end(), item.key()) ==
+            kReportingFields.end())
       changes.push_back(fmt::format("{} {} instead of {}", item.key(), after[item.key()].dump(),
                                     item.value().dump()));
   return changes;

@@ -1,6 +1,7 @@
 #pragma once
 // Every hyper-parameter of a training run, the presets that fill them in, and their JSON form
 // (the file saved beside the outputs, and the config files users pass in).
+#include <array>
 #include <nlohmann/json_fwd.hpp>
 
 #include <cstdint>
@@ -64,8 +65,14 @@ TrainConfig make_preset(const std::string& name, int64_t iterations = 0);
 // reports stay.
 void rescale_schedule(TrainConfig& config, int64_t iterations);
 
+// The fields that say how a training reports and saves itself, not what it learns: --resume takes
+// new values of them, and a cached stage is not trained again for them.
+inline constexpr std::array<const char*, 4> kReportingFields = {"checkpoint_every", "test_every",
+                                                                "test_views", "log_every"};
+
 nlohmann::json to_json(const TrainConfig& config);
-// The fields in which `to` differs from `from`, each as "key <to's value> instead of <from's>".
+// The fields but kReportingFields in which `to` differs from `from`, each as "key <to's value>
+// instead of <from's>".
 std::vector<std::string> config_changes(const TrainConfig& from, const TrainConfig& to);
 // Overrides the fields present in `json`; unknown keys and wrong types are errors naming `origin`.
 void apply_json(TrainConfig& config, const nlohmann::json& json, const std::string& origin);

@@ -333,6 +333,10 @@ TEST_F(RunCli, AStoppedRerunLeavesNothingOfTheEarlierRunThatReadsAsItsOwn) {
   ASSERT_EQ(damaged.status, 0) << damaged.output;
   EXPECT_FALSE(contains(damaged.output, "settings or inputs changed")) << damaged.output;
   EXPECT_TRUE(finished("external"));
+  // How a training reports and checkpoints is not what it learns: the stage is reused.
+  const CliRun reporting = run_rows("external", " --set seed=4 --set checkpoint_every=3");
+  ASSERT_EQ(reporting.status, 0) << reporting.output;
+  EXPECT_TRUE(contains(reporting.output, "fusion: reusing the finished model")) << reporting.output;
 
   // iesrgs internal leaves the table alone while its model stays, and not once it changes.
   const std::string internal = "internal " + scene + " -o " + out + kTinySchedule;

@@ -309,6 +309,11 @@ TEST(TrainCli, ResumeOfAFinishedRunKeepsItsModelAndReport) {
       << reseeded.output;
   const CliRun repeated = iesrgs(train + " --resume --set random_points=500 --iterations 10");
   EXPECT_EQ(repeated.status, 0) << repeated.output;
+  // How the run reports and checkpoints may change, and the saved config says how it now does.
+  const CliRun reporting = iesrgs(train + " --resume --set checkpoint_every=3 --set log_every=1");
+  ASSERT_EQ(reporting.status, 0) << reporting.output;
+  EXPECT_EQ(read_file(dir / "run" / "point_cloud.ply"), model);
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir / "run" / "config.json"))["checkpoint_every"], 3);
   const CliRun doubled = iesrgs(train + " --resume --iterations 20");
   EXPECT_EQ(doubled.status, 1);
   EXPECT_TRUE(contains(last_line(doubled.output), "iterations 20 instead of 10") &&

@@ -127,6 +127,19 @@ TEST(TrainConfig, JsonRoundTripsEveryField) {
   EXPECT_EQ(to_json(c), every_field);  // no field more, none less, written as read
 }
 
+// What --resume and a cached stage compare: what the training learns, not how it reports.
+TEST(TrainConfig, ChangesLeaveOutHowATrainingReports) {
+  const TrainConfig run = make_preset("fast");
+  TrainConfig other = run;
+  other.checkpoint_every = 7;
+  other.test_every = 7;
+  other.test_views = 7;
+  other.log_every = 7;
+  EXPECT_TRUE(config_changes(run, other).empty());
+  other.seed = 3;
+  EXPECT_EQ(config_changes(run, other), std::vector<std::string>{"seed 3 instead of 0"});
+}
+
 TEST(TrainConfig, AssignmentsParseValues) {
   TrainConfig c;
   apply_assignment(c, "grad_threshold=0.0003");
