@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -36,6 +37,16 @@ constexpr std::string_view kTemporaryMark = ".tmp-";
 
 std::array<InProgressSlot, 64> in_progress;
 
+fs::path parent_folder(const fs::path& path) {
+  return path.has_parent_path() ? path.parent_path() : fs::path(".");
+}
+
+void move_into_place(const fs::path& tmp, const fs::path& path) {
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) fail_file(path, "cannot move finished file into place: " + ec.message());
+}
+
 fs::path temporary_path(const fs::path& path) {
   return path.string() + std::string(kTemporaryMark) + std::to_string(::getpid());
 }
@@ -63,16 +74,15 @@ bool is_stale_temporary(const fs::path& path) {
 }  // namespace
 
 void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write) {
-  std::error_code ec;
-  CreatedFolders folders(path.has_parent_path() ? path.parent_path() : fs::path("."));
+  CreatedFolders folders(parent_folder(path));
   const fs::path tmp = temporary_path(path);
   const InProgress listed(tmp.string());
   try {
     errno = 0;  // for close_written
     write(tmp);
-    fs::rename(tmp, path, ec);
-    if (ec) fail_file(path, "cannot move finished file into place: " + ec.message());
+    move_into_place(tmp, path);
   } catch (...) {
+    std::error_code ec;
     fs::remove(tmp, ec);
     folders.remove_empty();
     throw;
@@ -122,24 +132,33 @@ InProgress::~InProgress() {
   slot_->taken = false;
 }
 
+// One level at a time, so that only the folders this call made are listed (not one another
+// process made meanwhile, nor a link to nothing, which counts as missing to fs::exists).
 CreatedFolders::CreatedFolders(const fs::path& folder) {
+  fs::path path;
+  for (const fs::path& part : folder) {
+    if (part.empty()) continue;  // a trailing separator
+    path /= part;
+    if (::mkdir(path.c_str(), 0777) == 0) {
+      created_.insert(created_.begin(), path);
+      listed_.push_back(std::make_unique<InProgress>(fs::absolute(path).string(), true));
+    } else if (errno != EEXIST) {
+      const std::string reason = std::strerror(errno);
+      remove_empty();  // the parents made before the failure
+      fail_file(path, "cannot create the folder (" + reason + ")");
+    }
+  }
   std::error_code ec;
-  for (fs::path missing = folder; !missing.empty() && !fs::exists(missing, ec);
-       missing = missing.parent_path())
-    created_.push_back(missing);
-  for (const fs::path& created : created_)
-    listed_.push_back(std::make_unique<InProgress>(fs::absolute(created).string(), true));
-  fs::create_directories(folder, ec);
-  if (ec) {
-    remove_empty();  // the parents made before the failure
-    fail_file(folder, "cannot create the folder (" + ec.message() + ")");
+  if (!fs::is_directory(folder, ec)) {
+    remove_empty();
+    fail_file(folder, "cannot create the folder: something else has its name");
   }
 }
 
 void CreatedFolders::remove_empty() {
-  std::error_code ec;
+  // rmdir: never a file or a link, and never a folder that holds something.
   for (const fs::path& folder : created_)
-    if (!fs::remove(folder, ec)) break;  // not empty: this and every parent stay
+    if (::rmdir(folder.c_str()) != 0) break;  // not empty: this and every parent stay
   forget();
 }
 
@@ -160,29 +179,35 @@ void remove_temporaries_in_progress() {
   }
 }
 
-namespace {
-
-// Each file's temporary is written inside the previous one's write, so that the renames come
-// last, the last file's first.
-void write_files_from(const std::vector<std::pair<fs::path, std::string>>& files, size_t first) {
-  if (first == files.size()) return;
-  const auto& [path, bytes] = files[first];
-  write_atomically(path, [&](const fs::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    close_written(out, path);
-    write_files_from(files, first + 1);
-  });
-}
-
-}  // namespace
-
 void write_file_atomically(const fs::path& path, const std::string& bytes) {
-  write_files_from({{path, bytes}}, 0);
+  write_files_atomically({{path, bytes}});
 }
 
 void write_files_atomically(const std::vector<std::pair<fs::path, std::string>>& files) {
-  write_files_from(files, 0);
+  std::vector<std::unique_ptr<CreatedFolders>> folders;
+  std::vector<std::unique_ptr<InProgress>> listed;
+  std::vector<fs::path> temporaries;
+  size_t renamed = 0;
+  try {
+    for (const auto& [path, bytes] : files) {
+      folders.push_back(std::make_unique<CreatedFolders>(parent_folder(path)));
+      temporaries.push_back(temporary_path(path));
+      listed.push_back(std::make_unique<InProgress>(temporaries.back().string()));
+      errno = 0;  // for close_written
+      std::ofstream out(temporaries.back(), std::ios::binary);
+      out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      close_written(out, path);
+    }
+    for (; renamed < files.size(); ++renamed)
+      move_into_place(temporaries[renamed], files[renamed].first);
+  } catch (...) {
+    std::error_code ec;
+    for (size_t i = 0; i < temporaries.size(); ++i)
+      fs::remove(i < renamed ? files[i].first : temporaries[i], ec);
+    for (auto folder = folders.rbegin(); folder != folders.rend(); ++folder)
+      (*folder)->remove_empty();
+    throw;
+  }
 }
 
 std::string write_failure(int error) {

@@ -85,6 +85,19 @@ TEST(AtomicFile, AnEarlierOutputNotThereIsNotRemoved) {
       << message;
 }
 
+// Only the folders a write made go when it fails: here the parent it made before a name too long
+// to make, and never a link to nothing that stands where a folder should be.
+TEST(AtomicFile, AFailedWriteRemovesOnlyTheFoldersItMade) {
+  TempDir dir;
+  EXPECT_ANY_THROW(write_file_atomically(dir / "new" / std::string(300, 'x') / "m.json", "{}"));
+  EXPECT_FALSE(fs::exists(dir / "new"));
+  fs::create_symlink(dir / "nowhere", dir / "link");
+  const std::string message =
+      testing::error_message([&] { write_file_atomically(dir / "link" / "m.json", "{}"); });
+  EXPECT_TRUE(testing::contains(message, "link: cannot create the folder")) << message;
+  EXPECT_TRUE(fs::is_symlink(dir / "link"));
+}
+
 // Beside a file written into any folder (export's, eval's), only that file's temporaries that a
 // killed writer left go (no process has a pid of 999999999), and not a running writer's.
 TEST(AtomicFile, AFilesOwnStaleTemporariesAreRemoved) {

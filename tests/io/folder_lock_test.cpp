@@ -55,6 +55,8 @@ TEST(FolderLock, FoldersItCreatedAndLeftEmptyAreRemoved) {
   TempDir dir;
   { FolderLock unused(dir / "new" / "run"); }
   EXPECT_FALSE(std::filesystem::exists(dir / "new"));
+  { FolderLock unused(dir / "slash" / "run/"); }  // as -o slash/run/ names it
+  EXPECT_FALSE(std::filesystem::exists(dir / "slash"));
   {
     FolderLock written(dir / "kept" / "run");
     std::ofstream(dir / "kept" / "run" / "out.txt") << "x";
