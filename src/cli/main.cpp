@@ -27,6 +27,8 @@ std::string option_error(const CLI::App* app, const CLI::Error& error) {
   if (error.get_name() != "RequiredError" || command->get_require_subcommand_min() == 0 ||
       command->get_subcommands().size() >= command->get_require_subcommand_min())
     return fmt::format("error: {} (--help lists the options)\n", error.what());
+  if (!unknown.empty() && unknown.front().rfind('-', 0) == 0)
+    return fmt::format("error: unknown option '{}' (--help lists the options)\n", unknown.front());
   std::vector<std::string> known;
   for (const CLI::App* sub : command->get_subcommands([](const CLI::App*) { return true; }))
     known.push_back(sub->get_name());

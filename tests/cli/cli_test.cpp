@@ -82,6 +82,8 @@ TEST(Cli, AnUnknownCommandIsNamedWithTheKnownOnes) {
   EXPECT_EQ(last_line(iesrgs("bench rastr").output),
             "error: unknown bench mode 'rastr' (known: raster, ssim, adam)");
   EXPECT_TRUE(contains(last_line(iesrgs("").output), "error: no command given (known: "));
+  EXPECT_EQ(last_line(iesrgs("bench -n 5").output),
+            "error: unknown option '-n' (--help lists the options)");
 }
 
 TEST(Cli, MissingSceneIsOneLineNamingThePath) {
