@@ -12,6 +12,7 @@
 #include "cli/shared_options.hpp"
 #include "cli/validators.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/memory.hpp"
 #include "io/atomic_file.hpp"
 #include "io/folder_lock.hpp"
@@ -121,6 +122,9 @@ void run_train(const TrainArgs& args) {
                  out.string());
   // Again on --resume: it may report and checkpoint otherwise.
   write_file_atomically(out / "config.json", train::to_json(config).dump(2) + "\n");
+  // Across the model's files after training too: a stop asked for while they are written lets
+  // them finish (training's own scope would otherwise give the signal back to end_now).
+  const InterruptScope finishing;
   const train::TrainSummary summary = trainer.run();
   if (summary.interrupted) throw Interrupted("continue with the same command and --resume");
   train::write_point_clouds(out, trainer);
