@@ -12,16 +12,23 @@
 
 namespace iesrgs {
 
+// What a reader does with a record holding a value that is not finite.
+enum class NonFinite { LeaveOut, Refuse };
+
 class NonFiniteRecords {
  public:
   // `what`: a record's name in the messages ("Gaussian", "point").
-  NonFiniteRecords(const std::filesystem::path& name, const char* what)
-      : name_(name), what_(what) {}
+  NonFiniteRecords(const std::filesystem::path& name, const char* what,
+                   NonFinite policy = NonFinite::LeaveOut)
+      : name_(name), what_(what), policy_(policy) {}
 
-  // One left out; `describe()` says why, and is called for the first only.
+  // One left out, or refused (an Error naming the file); `describe()` says why, and is called for
+  // the first only.
   template <typename Describe>
   void add(Describe describe) {
-    if (count_++ == 0) first_ = describe();
+    if (count_++ > 0) return;
+    first_ = describe();
+    if (policy_ == NonFinite::Refuse) fail_file(name_, first_);
   }
 
   // After the file's `total` records: a warning when some were left out, an Error naming the
@@ -36,6 +43,7 @@ class NonFiniteRecords {
  private:
   const std::filesystem::path& name_;
   const char* what_;
+  NonFinite policy_;
   size_t count_ = 0;
   std::string first_;
 };

@@ -478,8 +478,8 @@ std::string not_finite(size_t vertex, std::string_view property, double value) {
 // Each vertex is written over the first row not yet kept, and the arrays cut to those kept.
 template <typename Values>
 void read_body(Values values, const Header& header, const std::vector<const Slot*>& targets,
-               SplatCloud& cloud, const fs::path& name) {
-  NonFiniteRecords left_out(name, "Gaussian");
+               SplatCloud& cloud, const fs::path& name, NonFinite non_finite) {
+  NonFiniteRecords left_out(name, "Gaussian", non_finite);
   size_t kept = 0;
   for (size_t i = 0; i < header.vertex_count; ++i) {
     values.begin_vertex(i);
@@ -602,11 +602,11 @@ void write_ply_filter_baked(const fs::path& path, const SplatCloud& cloud) {
   write_ply(path, bake_filter_3d(cloud));
 }
 
-SplatCloud read_ply(const fs::path& path) {
-  return parse_ply(read_file(path), path);
+SplatCloud read_ply(const fs::path& path, NonFinite non_finite) {
+  return parse_ply(read_file(path), path, non_finite);
 }
 
-SplatCloud parse_ply(std::string_view bytes, const fs::path& name) {
+SplatCloud parse_ply(std::string_view bytes, const fs::path& name, NonFinite non_finite) {
   const Header header = HeaderParser(bytes, name).parse();
   const int sh_degree = infer_sh_degree(header, name);
   const bool has_filter = std::any_of(header.properties.begin(), header.properties.end(),
@@ -617,9 +617,9 @@ SplatCloud parse_ply(std::string_view bytes, const fs::path& name) {
   check_count_fits(header, body.size(), name);
   SplatCloud cloud = allocate(header, slots, sh_degree);
   if (header.ascii)
-    read_body(AsciiValues(body, name), header, targets, cloud, name);
+    read_body(AsciiValues(body, name), header, targets, cloud, name, non_finite);
   else
-    read_body(BinaryValues(body), header, targets, cloud, name);
+    read_body(BinaryValues(body), header, targets, cloud, name, non_finite);
   cloud.antialiased = has_filter;
   cloud.background = header.background;
   return cloud;

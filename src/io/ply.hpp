@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "io/non_finite_records.hpp"
 #include "io/point_cloud.hpp"
 
 namespace iesrgs {
@@ -61,12 +62,14 @@ void write_ply_filter_baked(const std::filesystem::path& path, const SplatCloud&
 // the number of f_rest properties. A .ply has no flag for the 2D filter: the cloud is antialiased
 // when it has Mip-Splatting's filter_3D, which only its trainers write, and otherwise is drawn as
 // 3DGS and the viewers draw it (this includes write_ply_filter_baked's own output). A vertex
-// holding a value that is not a finite float is left out, with a warning (NonFiniteRecords).
-// Throws Error naming the file for anything it cannot use.
-SplatCloud read_ply(const std::filesystem::path& path);
+// holding a value that is not a finite float is left out, with a warning (NonFiniteRecords), or,
+// for a file only iesrgs writes (a stage's own model, where one means damage), refused. Throws
+// Error naming the file for anything it cannot use.
+SplatCloud read_ply(const std::filesystem::path& path, NonFinite non_finite = NonFinite::LeaveOut);
 
 // read_ply on bytes already in memory; `name` is only used in error messages.
-SplatCloud parse_ply(std::string_view bytes, const std::filesystem::path& name);
+SplatCloud parse_ply(std::string_view bytes, const std::filesystem::path& name,
+                     NonFinite non_finite = NonFinite::LeaveOut);
 
 // The x y z and red green blue of a point cloud's vertices, as nerfstudio reads a scene's
 // ply_file_path: ascii or binary_little_endian, any scalar types, colours as bytes or, stored as

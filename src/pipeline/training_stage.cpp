@@ -51,7 +51,8 @@ StageResult run_training_stage(const std::string& name, const nlohmann::json& pa
   std::optional<double> finished_seconds;
   if (model_finished(dir, identity)) {
     try {
-      gs::GaussianModel model = gs::model_from_splat_cloud(read_ply(train::model_path(dir)));
+      gs::GaussianModel model =
+          gs::model_from_splat_cloud(read_ply(train::model_path(dir), NonFinite::Refuse));
       fmt::print("{}: reusing the finished model in {}\n", name, dir.string());
       return {std::move(model), stage_seconds(dir), true};
     } catch (const Error& e) {

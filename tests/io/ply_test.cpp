@@ -387,6 +387,9 @@ TEST(Ply, VerticesHoldingNonFiniteValuesAreLeftOutWithAWarning) {
   // Vertex 1's x, after vertex 0's 27 floats (3 + 3 normals + 3 + 9 + 1 + 3 + 4 + 1).
   std::memcpy(&bytes[header_of(bytes).size() + 27 * sizeof(float)], &inf, sizeof(float));
   testing::CapturedLog log;
+  EXPECT_TRUE(
+      testing::contains(error_message([&] { parse_ply(bytes, "own.ply", NonFinite::Refuse); }),
+                        "own.ply: vertex 1: property 'x' is not a finite float (inf)"));
   expect_same(parse_ply(bytes, "part.ply"), without(cloud, 1));
   EXPECT_EQ(log.count("part.ply: 1 of 4 Gaussians are left out for holding a value that is not "
                       "finite (first, vertex 1: property 'x' is not a finite float (inf))"),

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <csignal>
+#include <cstring>
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
@@ -111,9 +113,10 @@ TEST(TrainingStage, UnresumableCheckpointTrainsTheStageAgain) {
   EXPECT_TRUE(training_stage_current(dir / "stage", {}, run.config));
 }
 
-// A finished model damaged since it was written comes back from the final checkpoint, without
-// training and with its recorded time, on which later stages are keyed; with the checkpoint gone
-// too, the stage trains again.
+// A finished model damaged since it was written (cut short, or holding a NaN, which training
+// never saves and other readers leave out) comes back from the final checkpoint, without training
+// and with its recorded time, on which later stages are keyed; with the checkpoint gone too, the
+// stage trains again.
 TEST(TrainingStage, DamagedFinishedModelIsWrittenAgain) {
   TempDir dir;
   const StageRun run = tiny_stage(dir / "scene", dir / "stage");
@@ -121,15 +124,21 @@ TEST(TrainingStage, DamagedFinishedModelIsWrittenAgain) {
   const StageResult first = run_training_stage("stage", {}, run.config, run.setup, start);
   const std::filesystem::path ply = dir / "stage" / "point_cloud.ply";
   const std::string intact = read_file(ply);
-  write_file_atomically(ply, intact.substr(0, 300));
+  std::string not_finite = intact;
+  const float nan = std::nanf("");
+  std::memcpy(&not_finite[not_finite.find("end_header\n") + 11], &nan, sizeof nan);
 
   const auto no_new_start = []() -> gs::GaussianModel { throw std::runtime_error("drawn"); };
-  const StageResult restored = run_training_stage("stage", {}, run.config, run.setup, no_new_start);
-  EXPECT_FALSE(restored.cached);
-  EXPECT_EQ(read_file(ply), intact);
-  EXPECT_EQ(restored.model.size(), first.model.size());
-  EXPECT_EQ(restored.seconds, first.seconds);
-  EXPECT_EQ(stage_seconds(dir / "stage"), first.seconds);
+  for (const std::string& damaged : {intact.substr(0, 300), not_finite}) {
+    write_file_atomically(ply, damaged);
+    const StageResult restored =
+        run_training_stage("stage", {}, run.config, run.setup, no_new_start);
+    EXPECT_FALSE(restored.cached);
+    EXPECT_EQ(read_file(ply), intact);
+    EXPECT_EQ(restored.model.size(), first.model.size());
+    EXPECT_EQ(restored.seconds, first.seconds);
+    EXPECT_EQ(stage_seconds(dir / "stage"), first.seconds);
+  }
 
   write_file_atomically(ply, intact.substr(0, 300));
   std::filesystem::remove(train::checkpoint_path(dir / "stage"));
