@@ -136,10 +136,7 @@ void add_info_command(CLI::App& app) {
                     "fail on the first bad one");
   command->callback([args, load_images] {
     const std::filesystem::path path = args->path;
-    const bool training_folder =
-        !is_scene(path) && (std::filesystem::exists(train::model_path(path)) ||
-                            std::filesystem::exists(train::checkpoint_path(path)));
-    if (is_model_file(path) || training_folder) {
+    if (is_model_file(path) || (!is_scene(path) && train::is_training_folder(path))) {
       print_model_summary(train::trained_model_file(path));
       return;
     }

@@ -106,6 +106,12 @@ std::filesystem::path trained_model_file(const std::filesystem::path& path) {
                         (std::filesystem::exists(path / "stage.json")
                              ? "the iesrgs run, internal or fuse command that made it continues it"
                              : "the same train command with --resume continues it"));
+  if (!std::filesystem::exists(model) && std::filesystem::exists(path / "train_log.csv"))
+    fail_file(path, std::string("its training stopped before its first checkpoint, so it holds "
+                                "no model yet: ") +
+                        (std::filesystem::exists(path / "stage.json")
+                             ? "the iesrgs run, internal or fuse command that made it trains it"
+                             : "train it again (--resume has nothing to continue)"));
   if (!std::filesystem::exists(model) && is_run_folder(path)) {
     const std::vector<std::filesystem::path> models = run_folder_models(path);
     fail_file(path, models.empty() ? std::string("a run folder of iesrgs run, with no model yet")
@@ -115,6 +121,12 @@ std::filesystem::path trained_model_file(const std::filesystem::path& path) {
                                                  models.front().parent_path().string()));
   }
   return model;
+}
+
+bool is_training_folder(const std::filesystem::path& dir) {
+  return std::filesystem::exists(model_path(dir)) ||
+         std::filesystem::exists(checkpoint_path(dir)) ||
+         std::filesystem::exists(dir / "train_log.csv");
 }
 
 bool is_run_folder(const std::filesystem::path& dir) {

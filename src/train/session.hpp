@@ -55,6 +55,10 @@ bool remove_earlier_run(const std::filesystem::path& dir);
 // Error for a folder whose training has not finished, and for a run folder of iesrgs run.
 std::filesystem::path trained_model_file(const std::filesystem::path& path);
 
+// A folder a training wrote into: its model, its checkpoint, or the log of one stopped before
+// its first checkpoint.
+bool is_training_folder(const std::filesystem::path& dir);
+
 // A run folder of iesrgs run (or of iesrgs internal alone): rows/, or the internal stage.
 bool is_run_folder(const std::filesystem::path& dir);
 

@@ -4,7 +4,9 @@
 
 #include <vector>
 
+#include "support/expect_error.hpp"
 #include "support/looking_cameras.hpp"
+#include "support/temp_dir.hpp"
 
 namespace iesrgs::train {
 namespace {
@@ -16,6 +18,20 @@ Scene capture(const std::vector<Vec3>& eyes, const Vec3& target) {
   Scene scene;
   for (const Vec3& eye : eyes) scene.cameras.push_back(camera_at(eye, target));
   return scene;
+}
+
+// A training stopped before its first checkpoint left its log and config, and no model.
+TEST(TrainedModelFile, AFolderWithoutAModelSaysWhy) {
+  testing::TempDir dir;
+  testing::write_text(dir / "run" / "config.json", "{}");
+  testing::write_text(dir / "run" / "train_log.csv", "iteration\n");
+  EXPECT_TRUE(is_training_folder(dir / "run"));
+  EXPECT_TRUE(testing::contains(testing::error_message([&] { trained_model_file(dir / "run"); }),
+                                "its training stopped before its first checkpoint"));
+  testing::write_text(dir / "run" / "checkpoint.pt", "");
+  EXPECT_TRUE(testing::contains(testing::error_message([&] { trained_model_file(dir / "run"); }),
+                                "its training has not finished"));
+  EXPECT_FALSE(is_training_folder(dir.path()));
 }
 
 TEST(RandomBox, ConfiguredExtentIsACubeAroundTheOrigin) {
