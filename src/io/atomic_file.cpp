@@ -135,6 +135,7 @@ InProgress::~InProgress() {
 // One level at a time, so that only the folders this call made are listed (not one another
 // process made meanwhile, nor a link to nothing, which counts as missing to fs::exists).
 CreatedFolders::CreatedFolders(const fs::path& folder) {
+  std::error_code ec;
   fs::path path;
   for (const fs::path& part : folder) {
     if (part.empty()) continue;  // a trailing separator
@@ -142,13 +143,13 @@ CreatedFolders::CreatedFolders(const fs::path& folder) {
     if (::mkdir(path.c_str(), 0777) == 0) {
       created_.insert(created_.begin(), path);
       listed_.push_back(std::make_unique<InProgress>(fs::absolute(path).string(), true));
-    } else if (errno != EEXIST) {
-      const std::string reason = std::strerror(errno);
+    } else if (const int error = errno; error != EEXIST && !fs::is_directory(path, ec)) {
+      // Not EEXIST alone: NFS answers mkdir of an existing folder it may not write in with EACCES.
+      const std::string reason = std::strerror(error);
       remove_empty();  // the parents made before the failure
       fail_file(path, "cannot create the folder (" + reason + ")");
     }
   }
-  std::error_code ec;
   if (!fs::is_directory(folder, ec)) {
     remove_empty();
     fail_file(folder, "cannot create the folder: something else has its name");
@@ -187,6 +188,7 @@ void write_files_atomically(const std::vector<std::pair<fs::path, std::string>>&
   std::vector<std::unique_ptr<CreatedFolders>> folders;
   std::vector<std::unique_ptr<InProgress>> listed;
   std::vector<fs::path> temporaries;
+  std::vector<bool> replaces;  // an earlier output, which a removal could not bring back
   size_t renamed = 0;
   try {
     for (const auto& [path, bytes] : files) {
@@ -198,12 +200,16 @@ void write_files_atomically(const std::vector<std::pair<fs::path, std::string>>&
       out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
       close_written(out, path);
     }
+    std::error_code ec;
+    for (const auto& [path, bytes] : files)
+      replaces.push_back(fs::exists(fs::symlink_status(path, ec)));
     for (; renamed < files.size(); ++renamed)
       move_into_place(temporaries[renamed], files[renamed].first);
   } catch (...) {
     std::error_code ec;
     for (size_t i = 0; i < temporaries.size(); ++i)
-      fs::remove(i < renamed ? files[i].first : temporaries[i], ec);
+      if (i >= renamed || !replaces[i])
+        fs::remove(i < renamed ? files[i].first : temporaries[i], ec);
     for (auto folder = folders.rbegin(); folder != folders.rend(); ++folder)
       (*folder)->remove_empty();
     throw;

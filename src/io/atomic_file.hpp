@@ -21,9 +21,10 @@ void write_atomically(const std::filesystem::path& path,
 void write_file_atomically(const std::filesystem::path& path, const std::string& bytes);
 
 // Files that belong together (a report's .json and .csv), written as write_file_atomically
-// writes one: all of them complete before the first is renamed into place, and those renamed
-// removed again when a later one fails, so that a failure (a full disk) leaves none of them. A
-// signal that ends the process between two renames can leave the first ones.
+// writes one: all of them complete before the first is renamed into place, so that a failure to
+// write (a full disk) leaves none of them. When a later rename fails, those renamed before it are
+// removed again where they replaced nothing. A signal that ends the process between two renames
+// can leave the first ones.
 void write_files_atomically(
     const std::vector<std::pair<std::filesystem::path, std::string>>& files);
 

@@ -65,6 +65,15 @@ TEST(AtomicFile, FilesThatBelongTogetherAreWrittenAllOrNone) {
   EXPECT_ANY_THROW(write_files_atomically(files));
   for (const auto& [path, bytes] : files) EXPECT_FALSE(fs::exists(path)) << path;
   fs::remove_all(dir / ("b.csv.tmp-" + std::to_string(::getpid())));
+  // A rename that fails (a folder holds the name) takes back the files renamed before it, unless
+  // they replaced an earlier output, which a removal would not bring back.
+  fs::create_directories(dir / "b.csv" / "in-the-way");
+  EXPECT_ANY_THROW(write_files_atomically(files));
+  EXPECT_FALSE(fs::exists(dir / "a.json"));
+  write_file_atomically(dir / "a.json", "earlier");
+  EXPECT_ANY_THROW(write_files_atomically(files));
+  EXPECT_EQ(read_file(dir / "a.json"), "a");
+  fs::remove_all(dir / "b.csv");
   write_files_atomically(files);
   for (const auto& [path, bytes] : files) EXPECT_EQ(read_file(path), bytes);
 }
