@@ -1,5 +1,6 @@
 #include "io/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <fmt/core.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -214,6 +215,19 @@ void write_files_atomically(const std::vector<std::pair<fs::path, std::string>>&
       (*folder)->remove_empty();
     throw;
   }
+}
+
+void require_writable(const fs::path& file) {
+  CreatedFolders folders(parent_folder(file));
+  const fs::path tmp = temporary_path(file);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  const int error = errno;
+  if (fd >= 0) {
+    ::close(fd);
+    ::unlink(tmp.c_str());
+  }
+  folders.remove_empty();
+  if (fd < 0) fail_file(file, fmt::format("cannot be written ({})", std::strerror(error)));
 }
 
 std::string write_failure(int error) {

@@ -28,6 +28,10 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
 void write_files_atomically(
     const std::vector<std::pair<std::filesystem::path, std::string>>& files);
 
+// Checks before long work that `file` could be written (its folder made or there, a file created
+// in it), leaving nothing behind; throws Error naming what stands in the way.
+void require_writable(const std::filesystem::path& file);
+
 // "write failed: <the system's reason>" for an errno a failed write left, or a guess without one.
 std::string write_failure(int error);
 

@@ -398,6 +398,14 @@ TEST(Cli, EvalWritesNoReportOverItsInputs) {
   EXPECT_TRUE(contains(last_line(over_record.output), "would replace the renders' render.json"))
       << over_record.output;
   EXPECT_EQ(iesrgs("eval --lpips none " + renders + " " + scene).status, 0);  // metrics.json
+  // An output that cannot be written is named before any view is scored.
+  write_text(dir / "afile", "x");
+  const CliRun blocked =
+      iesrgs("eval --lpips none " + renders + " " + scene + " -o " + (dir / "afile/m").string());
+  EXPECT_EQ(blocked.status, 1);
+  EXPECT_TRUE(contains(last_line(blocked.output), "afile: cannot create the folder"))
+      << blocked.output;
+  EXPECT_FALSE(contains(blocked.output, "evaluated")) << blocked.output;
   const std::string nowhere = (dir / "nowhere").string();
   EXPECT_EQ(last_line(iesrgs("eval --lpips none " + nowhere + " " + scene).output),
             "error: " + nowhere + ": renders not found");
