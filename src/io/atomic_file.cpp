@@ -52,6 +52,41 @@ fs::path temporary_path(const fs::path& path) {
   return path.string() + std::string(kTemporaryMark) + std::to_string(::getpid());
 }
 
+using Writer = std::function<void(const fs::path&)>;
+
+// Every write here: each writer fills its file's temporary, all of them before the first rename.
+// On a failure the temporaries go, the renamed files that replaced nothing, and the folders made
+// for them.
+void write_set(const std::vector<std::pair<fs::path, Writer>>& files) {
+  std::vector<std::unique_ptr<CreatedFolders>> folders;
+  std::vector<std::unique_ptr<InProgress>> listed;
+  std::vector<fs::path> temporaries;
+  std::vector<bool> replaces;  // an earlier output, which a removal could not bring back
+  size_t renamed = 0;
+  try {
+    for (const auto& [path, write] : files) {
+      folders.push_back(std::make_unique<CreatedFolders>(parent_folder(path)));
+      temporaries.push_back(temporary_path(path));
+      listed.push_back(std::make_unique<InProgress>(temporaries.back().string()));
+      errno = 0;  // for close_written
+      write(temporaries.back());
+    }
+    std::error_code ec;
+    for (const auto& [path, write] : files)
+      replaces.push_back(fs::exists(fs::symlink_status(path, ec)));
+    for (; renamed < files.size(); ++renamed)
+      move_into_place(temporaries[renamed], files[renamed].first);
+  } catch (...) {
+    std::error_code ec;
+    for (size_t i = 0; i < temporaries.size(); ++i)
+      if (i >= renamed || !replaces[i])
+        fs::remove(i < renamed ? files[i].first : temporaries[i], ec);
+    for (auto folder = folders.rbegin(); folder != folders.rend(); ++folder)
+      (*folder)->remove_empty();
+    throw;
+  }
+}
+
 // A temporary of one of our outputs, "<name>.<ext>.tmp-<pid>" as temporary_path names them,
 // whose writer is no longer running. Other programs' files never match: only the extensions of
 // what iesrgs writes count.
@@ -75,19 +110,7 @@ bool is_stale_temporary(const fs::path& path) {
 }  // namespace
 
 void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write) {
-  CreatedFolders folders(parent_folder(path));
-  const fs::path tmp = temporary_path(path);
-  const InProgress listed(tmp.string());
-  try {
-    errno = 0;  // for close_written
-    write(tmp);
-    move_into_place(tmp, path);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    folders.remove_empty();
-    throw;
-  }
+  write_set({{path, write}});
 }
 
 void remove_stale_temporaries(const fs::path& folder) {
@@ -186,35 +209,14 @@ void write_file_atomically(const fs::path& path, const std::string& bytes) {
 }
 
 void write_files_atomically(const std::vector<std::pair<fs::path, std::string>>& files) {
-  std::vector<std::unique_ptr<CreatedFolders>> folders;
-  std::vector<std::unique_ptr<InProgress>> listed;
-  std::vector<fs::path> temporaries;
-  std::vector<bool> replaces;  // an earlier output, which a removal could not bring back
-  size_t renamed = 0;
-  try {
-    for (const auto& [path, bytes] : files) {
-      folders.push_back(std::make_unique<CreatedFolders>(parent_folder(path)));
-      temporaries.push_back(temporary_path(path));
-      listed.push_back(std::make_unique<InProgress>(temporaries.back().string()));
-      errno = 0;  // for close_written
-      std::ofstream out(temporaries.back(), std::ios::binary);
+  std::vector<std::pair<fs::path, Writer>> writers;
+  for (const auto& [path, bytes] : files)
+    writers.emplace_back(path, [&path = path, &bytes = bytes](const fs::path& tmp) {
+      std::ofstream out(tmp, std::ios::binary);
       out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
       close_written(out, path);
-    }
-    std::error_code ec;
-    for (const auto& [path, bytes] : files)
-      replaces.push_back(fs::exists(fs::symlink_status(path, ec)));
-    for (; renamed < files.size(); ++renamed)
-      move_into_place(temporaries[renamed], files[renamed].first);
-  } catch (...) {
-    std::error_code ec;
-    for (size_t i = 0; i < temporaries.size(); ++i)
-      if (i >= renamed || !replaces[i])
-        fs::remove(i < renamed ? files[i].first : temporaries[i], ec);
-    for (auto folder = folders.rbegin(); folder != folders.rend(); ++folder)
-      (*folder)->remove_empty();
-    throw;
-  }
+    });
+  write_set(writers);
 }
 
 void require_writable(const fs::path& file) {
