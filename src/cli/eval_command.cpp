@@ -186,8 +186,8 @@ void run_eval(const EvalArgs& args) {
   // The ground truth over the background the renders were drawn over, as 3DGS scores its renders.
   if (!options.background) options.background = rendered_over;
   const std::filesystem::path base = report_base(args);
-  // Before the scoring, which LPIPS makes long.
-  for (const char* extension : {".json", ".csv"}) require_writable(base.string() + extension);
+  // Before the scoring, which LPIPS makes long. The two files share their folder.
+  require_writable(base.string() + ".json");
   GroundTruth truth(args, options);
   const eval::LoadedLpips lpips = eval::load_default_lpips(args.lpips);
   eval::MetricsReport report;
