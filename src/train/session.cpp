@@ -100,18 +100,21 @@ bool remove_earlier_run(const std::filesystem::path& dir) {
 std::filesystem::path trained_model_file(const std::filesystem::path& path) {
   if (!std::filesystem::is_directory(path)) return path;
   const std::filesystem::path model = model_path(path);
-  if (!std::filesystem::exists(model) && std::filesystem::exists(checkpoint_path(path)))
-    fail_file(path, std::string("its training has not finished (a checkpoint, no "
-                                "point_cloud.ply yet): ") +
-                        (std::filesystem::exists(path / "stage.json")
-                             ? "the iesrgs run, internal or fuse command that made it continues it"
-                             : "the same train command with --resume continues it"));
-  if (!std::filesystem::exists(model) && std::filesystem::exists(path / "train_log.csv"))
-    fail_file(path, std::string("its training stopped before its first checkpoint, so it holds "
-                                "no model yet: ") +
-                        (std::filesystem::exists(path / "stage.json")
-                             ? "the iesrgs run, internal or fuse command that made it trains it"
-                             : "train it again (--resume has nothing to continue)"));
+  if (!std::filesystem::exists(model)) {
+    // A run's stage folder is trained by the command that made it, not by train.
+    const bool stage = std::filesystem::exists(path / "stage.json");
+    constexpr const char* kRunCommand = "the iesrgs run, internal or fuse command that made it";
+    if (std::filesystem::exists(checkpoint_path(path)))
+      fail_file(path, fmt::format("its training has not finished (a checkpoint, no "
+                                  "point_cloud.ply yet): {}",
+                                  stage ? fmt::format("{} continues it", kRunCommand)
+                                        : "the same train command with --resume continues it"));
+    if (std::filesystem::exists(path / "train_log.csv"))
+      fail_file(path, fmt::format("its training stopped before its first checkpoint, so it holds "
+                                  "no model yet: {}",
+                                  stage ? fmt::format("{} trains it", kRunCommand)
+                                        : "train it again (--resume has nothing to continue)"));
+  }
   if (!std::filesystem::exists(model) && is_run_folder(path)) {
     const std::vector<std::filesystem::path> models = run_folder_models(path);
     fail_file(path, models.empty() ? std::string("a run folder of iesrgs run, with no model yet")
