@@ -5,8 +5,11 @@
 #include <spdlog/spdlog.h>
 #include <torch/torch.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "cli/commands.hpp"
@@ -37,6 +40,17 @@ std::string option_error(const CLI::App* app, const CLI::Error& error) {
                      unknown.empty() ? fmt::format("no {} given", what)
                                      : fmt::format("unknown {} '{}'", what, unknown.front()),
                      fmt::join(known, ", "));
+}
+
+// Whether everything printed reached stdout: a full disk or a closed pipe behind it is a failure,
+// never a success.
+bool stdout_written() {
+  return std::fflush(stdout) == 0 && !std::ferror(stdout);
+}
+
+// fmt says "cannot write to file" without naming it; CLI11's help says nothing at all.
+std::string stdout_failure(const std::string& reason = std::strerror(errno)) {
+  return "cannot write to standard output: " + reason;
 }
 
 }  // namespace
@@ -81,11 +95,15 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    const int status = app.exit(e);
+    return status == 0 && !stdout_written() ? report(stdout_failure().c_str()) : status;
   } catch (const iesrgs::Interrupted& e) {
     std::fflush(stdout);
     std::fprintf(stderr, "interrupted: %s\n", e.what());
     return iesrgs::interrupt_exit_status();
+  } catch (const std::system_error& e) {
+    if (std::ferror(stdout)) return report(stdout_failure(e.code().message()).c_str());
+    return report(iesrgs::current_exception_message().c_str());
   } catch (...) {
     return report(iesrgs::current_exception_message().c_str());
   }
@@ -97,5 +115,5 @@ int main(int argc, char** argv) {
                  "interrupted: after the command had done its work; its outputs are whole\n");
     return iesrgs::interrupt_exit_status();
   }
-  return 0;
+  return stdout_written() ? 0 : report(stdout_failure().c_str());
 }

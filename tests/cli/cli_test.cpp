@@ -86,6 +86,14 @@ TEST(Cli, AnUnknownCommandIsNamedWithTheKnownOnes) {
             "error: unknown option '-n' (--help lists the options)");
 }
 
+// A full disk behind stdout: help and a printed summary fail rather than claim success.
+TEST(Cli, AFullStandardOutputIsAFailure) {
+  EXPECT_EQ(iesrgs("--help > /dev/full").status, 1);
+  EXPECT_EQ(iesrgs("--version > /dev/full").status, 1);
+  EXPECT_EQ(iesrgs("bench adam --gaussians 100 --iterations 1 > /dev/full").status, 1);
+  EXPECT_EQ(iesrgs("--help > /dev/null").status, 0);
+}
+
 TEST(Cli, MissingSceneIsOneLineNamingThePath) {
   TempDir dir;
   const CliRun run = iesrgs("info " + (dir / "nowhere").string());
