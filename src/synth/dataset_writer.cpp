@@ -137,6 +137,12 @@ std::vector<std::string> index_files() {
   return files;
 }
 
+// sparse/ alone makes a COLMAP scene; kept when it holds anything else.
+void remove_empty_sparse_folders(const fs::path& dir) {
+  std::error_code ec;
+  for (const fs::path& folder : {dir / "sparse" / "0", dir / "sparse"}) fs::remove(folder, ec);
+}
+
 // Refuses a folder holding a scene synth did not write, or has since changed (a capture's COLMAP
 // model is not synth's to replace); in one it did, removes those files, so that until this scene
 // is whole the folder is none, rather than the earlier cameras over some new images.
@@ -159,8 +165,7 @@ void replace_earlier_scene(const fs::path& dir) {
     present.push_back(dir / name);
   }
   for (const fs::path& file : present) remove_earlier_output(file, "left by an earlier scene");
-  // sparse/ alone makes a COLMAP scene; kept when it holds anything else.
-  for (const fs::path& folder : {dir / "sparse" / "0", dir / "sparse"}) fs::remove(folder, ec);
+  remove_empty_sparse_folders(dir);
 }
 
 // Written once the scene is whole: its options, and the digests replace_earlier_scene checks.
@@ -197,7 +202,15 @@ void write_synth_dataset(const fs::path& dir, const SynthOptions& options,
   else
     writer.write_blender({{"train", train_orbit(options.train_views, options.seed)},
                           {"test", test_orbit(options.test_views)}});
-  record_scene(dir, options);
+  try {
+    record_scene(dir, options);
+  } catch (...) {
+    // A scene without its record would be refused by the next synth as not synth's own.
+    std::error_code ec;
+    for (const std::string& name : index_files()) fs::remove(dir / name, ec);
+    remove_empty_sparse_folders(dir);
+    throw;
+  }
 }
 
 }  // namespace iesrgs::synth

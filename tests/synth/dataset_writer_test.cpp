@@ -170,6 +170,23 @@ TEST(SynthDataset, AStoppedSceneIsNoScene) {
   }
 }
 
+// A record that cannot be written (here a folder stands in its place) leaves no scene: one without
+// its record would be refused by the next synth as another's.
+TEST(SynthDataset, ASceneWhoseRecordFailsIsNoScene) {
+  for (const SynthFormat format : {SynthFormat::Blender, SynthFormat::Colmap}) {
+    TempDir dir;
+    std::filesystem::create_directories(dir / "synth.json" / "in-the-way");
+    SynthOptions options = tiny();
+    options.format = format;
+    EXPECT_FALSE(error_message([&] { write_synth_dataset(dir.path(), options); }).empty());
+    EXPECT_FALSE(is_scene(dir.path()));
+    EXPECT_FALSE(std::filesystem::exists(dir / "sparse"));
+    std::filesystem::remove_all(dir / "synth.json");
+    write_synth_dataset(dir.path(), options);
+    EXPECT_TRUE(is_scene(dir.path()));
+  }
+}
+
 // A capture's COLMAP model or a dataset's transforms are not synth's to replace, nor synth's own
 // once changed: only the files synth.json records, as it records them.
 TEST(SynthDataset, AFolderHoldingAnotherSceneIsRefusedUntouched) {
