@@ -299,6 +299,7 @@ Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
     camera.split = i % options.test_every == 0 ? Split::Test : Split::Train;
     scene.cameras.push_back(std::move(camera));
   }
+  require_images_exist(scene.cameras, files.images);
   scene.points = sfm_points(model, files);
   return scene;
 }

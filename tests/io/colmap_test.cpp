@@ -247,9 +247,18 @@ TEST(Colmap, ReadsModelsWrittenByColmap) {
   }
 }
 
+// The image files a model lists, empty: a scene's images are looked for as it loads, decoded later.
+void write_image_files(const fs::path& root, const ColmapModel& model) {
+  for (const auto& [id, image] : model.images) {
+    fs::create_directories((root / "images" / image.name).parent_path());
+    write_text(root / "images" / image.name, "");
+  }
+}
+
 // sample_model() as a COLMAP scene folder with the model in `model_dir` below `root`.
 void write_sample_scene(const fs::path& root, const std::string& model_dir = "sparse/0") {
   write_colmap_model_binary(root / model_dir, sample_model());
+  write_image_files(root, sample_model());
 }
 
 void expect_near(const Vec3& a, const Vec3& b) {
@@ -344,6 +353,15 @@ TEST(Colmap, DefaultHoldOutIsEveryEighthImage) {
   ASSERT_EQ(scene.split(Split::Test).size(), 1u);
   EXPECT_EQ(scene.split(Split::Test).front()->name, "frame_a");
   EXPECT_EQ(scene.split(Split::Train).size(), 5u);
+}
+
+// Looked for as the scene loads: not when a stage, perhaps hours on, reaches that view.
+TEST(Colmap, AnImageTheModelListsButImagesLacksIsNamedAtLoad) {
+  TempDir root;
+  write_sample_scene(root.path());
+  fs::remove(root / "images" / "frame_e.jpg");
+  expect_error([&] { load_scene(root.path()); },
+               {(root / "sparse/0/images.bin").string(), "frame_e.jpg not found"});
 }
 
 TEST(Colmap, LoadSceneDispatchesToColmap) {
@@ -587,6 +605,7 @@ TEST(Colmap, FisheyeCamerasKeepTheirTerms) {
   model.cameras[3] = {3, "RADIAL_FISHEYE", 1024, 768, {900, 512, 384, 0.05, 0.01}};
   model.cameras[1] = {1, "SIMPLE_FISHEYE", 640, 480, {500, 320, 240}};
   write_colmap_model_text(root / "sparse/0", model);
+  write_image_files(root.path(), model);
   const Scene scene = load_scene(root.path());
   const Distortion& opencv = camera_named(scene, "frame_d").distortion;
   EXPECT_TRUE(opencv.fisheye);
@@ -618,6 +637,7 @@ TEST(Colmap, FullOpencvKeepsItsRationalTerms) {
       1080,
       {1500.3, 1499.7, 960.2, 539.8, -0.1, 0.05, 0.001, -0.002, 0.01, 0.2, -0.03, 0.004}};
   write_colmap_model_text(root / "sparse/0", model);
+  write_image_files(root.path(), model);
   const Distortion d = camera_named(read_colmap_scene(root.path(), {}), "frame_d").distortion;
   EXPECT_EQ(d.k1, -0.1);
   EXPECT_EQ(d.p2, -0.002);
@@ -632,6 +652,7 @@ TEST(Colmap, UnusedCameraOfAnyModelIsIgnored) {
   ColmapModel model = sample_model();
   model.cameras[9] = {9, "FOV", 100, 100, {1, 1, 50, 50, 0.5}};
   write_colmap_model_text(root / "sparse/0", model);
+  write_image_files(root.path(), model);
   EXPECT_EQ(load_scene(root.path()).cameras.size(), model.images.size());
 }
 
