@@ -139,6 +139,24 @@ Scene read_any_format(const fs::path& root, const SceneOptions& options) {
             "transforms.json)");
 }
 
+// One image file under two cameras, however its paths are spelled: a test image would be trained
+// on, or one image given two poses.
+void require_distinct_images(const Scene& scene) {
+  std::map<fs::path, const Camera*> seen;
+  for (const Camera& camera : scene.cameras) {
+    std::error_code ec;
+    fs::path file = fs::weakly_canonical(camera.image_path, ec);
+    if (ec) file = camera.image_path.lexically_normal();
+    const auto [it, added] = seen.emplace(file, &camera);
+    if (!added)
+      fail_file(scene.root,
+                fmt::format("image {} is posed twice, as {} view '{}' and {} view '{}': "
+                            "one image has one camera; list it once",
+                            camera.image_path.string(), split_name(it->second->split),
+                            it->second->name, split_name(camera.split), camera.name));
+  }
+}
+
 void require_unique_names(const Scene& scene) {
   std::map<std::pair<Split, std::string>, const Camera*> seen;
   for (const Camera& camera : scene.cameras) {
@@ -258,6 +276,7 @@ Scene load_scene(const fs::path& given_root, const SceneOptions& options) {
   Scene scene = read_any_format(root, options);
   if (scene.cameras.empty()) fail_file(root, "scene has no cameras");
   scene.root = root;
+  require_distinct_images(scene);
   require_unique_names(scene);
   scene.background = options.background.value_or(scene.synthetic ? std::array<float, 3>{1, 1, 1}
                                                                  : std::array<float, 3>{0, 0, 0});

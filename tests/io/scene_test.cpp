@@ -56,11 +56,32 @@ TEST(Scene, TwoViewsOfASplitWithOneNameAreRefused) {
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 3, 1});
   const auto json_path = dir / "scene" / "transforms_train.json";
   nlohmann::json transforms = nlohmann::json::parse(read_file(json_path));
-  transforms["frames"][1]["file_path"] = "./test/r_0";  // a second train view named r_0
+  std::filesystem::create_directories(dir / "scene" / "other");
+  std::filesystem::copy_file(dir / "scene" / "test" / "r_0.png",
+                             dir / "scene" / "other" / "r_0.png");
+  transforms["frames"][1]["file_path"] = "./other/r_0";  // a second train view named r_0
   write_file_atomically(json_path, transforms.dump());
   const std::string message = error_message([&] { load_scene(dir / "scene"); });
   EXPECT_TRUE(contains(message, "train views named 'r_0'")) << message;
-  EXPECT_TRUE(contains(message, "test/r_0.png")) << message;
+  EXPECT_TRUE(contains(message, "other/r_0.png")) << message;
+}
+
+// One image under two cameras, however its path is spelled: a test image among the training
+// views, or one photo given two poses.
+TEST(Scene, AnImagePosedTwiceIsRefused) {
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 3, 1});
+  const auto json_path = dir / "scene" / "transforms_train.json";
+  const nlohmann::json original = nlohmann::json::parse(read_file(json_path));
+  for (const auto& [path, views] :
+       {std::pair{"./test/r_0", "train view 'r_0' and test view 'r_0'"},
+        std::pair{"train/../train/r_0.png", "train view 'r_0' and train view 'r_0'"}}) {
+    nlohmann::json transforms = original;
+    transforms["frames"][1]["file_path"] = path;
+    write_file_atomically(json_path, transforms.dump());
+    const std::string message = error_message([&] { load_scene(dir / "scene"); });
+    EXPECT_TRUE(contains(message, std::string("is posed twice, as ") + views)) << message;
+  }
 }
 
 // Read as a nerfstudio file, a split file would give a split of its own views.
