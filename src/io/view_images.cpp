@@ -21,20 +21,29 @@ std::string describe(const Intrinsics& k) {
   return fmt::format("{}x{}", k.width, k.height);
 }
 
-// The pre-downscaled copy, if present: the image's top folder below the scene root gets "_<k>"
-// (COLMAP / nerfstudio convention: images/cam0/a.png -> images_2/cam0/a.png). A scene given as
-// its transforms.json has that file's folder as its root.
-fs::path downscaled_copy(const fs::path& scene_root, const fs::path& image_path, int downscale) {
+// Where the pre-downscaled copy of an image would be: the image's top folder below the scene root
+// gets "_<k>" (COLMAP / nerfstudio convention: images/cam0/a.png -> images_2/cam0/a.png). A scene
+// given as its transforms.json has that file's folder as its root. Empty when there is none to
+// look for: no downscale, or an image not inside a folder of the scene.
+struct DownscaledCopy {
+  fs::path folder;  // images_<k>
+  fs::path file;
+};
+
+DownscaledCopy downscaled_copy(const fs::path& scene_root, const fs::path& image_path,
+                               int downscale) {
   if (downscale <= 1) return {};
   std::error_code ec;
   const fs::path root = fs::is_regular_file(scene_root, ec) ? scene_root.parent_path() : scene_root;
   const fs::path relative = image_path.lexically_relative(root);
   if (relative.empty() || *relative.begin() == ".." ||
       std::next(relative.begin()) == relative.end())
-    return {};  // not inside a folder of the scene
-  fs::path candidate = root / (relative.begin()->string() + "_" + std::to_string(downscale));
-  for (auto part = std::next(relative.begin()); part != relative.end(); ++part) candidate /= *part;
-  return fs::is_regular_file(candidate, ec) ? candidate : fs::path{};
+    return {};
+  DownscaledCopy copy;
+  copy.folder = root / (relative.begin()->string() + "_" + std::to_string(downscale));
+  copy.file = copy.folder;
+  for (auto part = std::next(relative.begin()); part != relative.end(); ++part) copy.file /= *part;
+  return copy;
 }
 
 // Identifies an undistorted result: the source's content and every parameter used.
@@ -130,8 +139,17 @@ Image8 ViewImages::undistorted(const Camera& camera, const Image8& source,
 }
 
 fs::path ViewImages::source_path(const Camera& camera) const {
-  const fs::path copy = downscaled_copy(scene_.root, camera.image_path, scene_.downscale);
-  return copy.empty() ? camera.image_path : copy;
+  const DownscaledCopy copy = downscaled_copy(scene_.root, camera.image_path, scene_.downscale);
+  std::error_code ec;
+  if (copy.file.empty()) return camera.image_path;
+  if (fs::is_regular_file(copy.file, ec)) return copy.file;
+  // A copy folder that lacks some images mixes two resizes of one scene: said, once.
+  if (fs::is_directory(copy.folder, ec) && !copy_missing_.exchange(true))
+    spdlog::warn(
+        "{}: holds no copy of {} (the first of the scene's images it lacks); such views "
+        "are resized from the stored images instead",
+        copy.folder.string(), camera.image_path.filename().string());
+  return camera.image_path;
 }
 
 std::string ViewImages::source_digest(const Camera& camera) const {

@@ -60,6 +60,7 @@ class ViewImages {
   mutable std::mutex digest_mutex_;
   mutable std::unordered_map<std::string, std::string> digests_;  // by source path
   mutable std::atomic<bool> cache_failed_{false};  // said once: the cause is every image's
+  mutable std::atomic<bool> copy_missing_{false};  // a copy folder lacking images, said once
 };
 
 }  // namespace iesrgs

@@ -104,6 +104,28 @@ TEST(ViewImages, ResizesWhenNoDownscaledCopyExists) {
   EXPECT_NEAR(rgb->at(2, 1, 1), 200 / 255.f, 1e-6);  // a constant image stays constant
 }
 
+// A copy folder lacking some images mixes two resizes of one scene: said once, naming the first.
+TEST(ViewImages, ACopyFolderLackingImagesIsSaidOnce) {
+  SceneFixture f;
+  Camera a = f.add("a.png", solid(8, 8, {255, 0, 0}));
+  Camera b = f.add("b.png", solid(8, 8, {255, 0, 0}));
+  Camera c = f.add("c.png", solid(8, 8, {255, 0, 0}));
+  write_png(f.dir / "images_2" / "a.png", solid(4, 4, {0, 255, 0}));
+  f.scene.downscale = 2;
+  for (Camera* camera : {&a, &b, &c}) camera->intrinsics = camera->stored.scaled(0.5);
+  testing::CapturedLog log;
+  ViewImages images(f.scene, f.options);
+  EXPECT_FLOAT_EQ(images.rgb(a)->at(1, 1, 1), 1.f);
+  EXPECT_FLOAT_EQ(images.rgb(b)->at(1, 1, 0), 1.f);  // red: resized from the stored image
+  images.rgb(c);
+  EXPECT_EQ(log.count((f.dir / "images_2").string() +
+                      ": holds no copy of b.png (the first of the scene's images it lacks); such "
+                      "views are resized from the stored images instead"),
+            1u)
+      << log.text();
+  EXPECT_EQ(log.count("holds no copy"), 1u) << log.text();
+}
+
 TEST(ViewImages, WrongImageSizeNamesTheFile) {
   SceneFixture f;
   Camera camera = f.add("a.png", solid(8, 6, {1, 2, 3}));
