@@ -54,8 +54,7 @@ void print_summary(const Scene& scene) {
   const SceneNormalization norm = scene.normalization();
   fmt::print("extent      center ({:.3f}, {:.3f}, {:.3f}) radius {:.3f}\n", norm.center.x,
              norm.center.y, norm.center.z, norm.radius);
-  if (const std::optional<std::string> warning = camera_spread_warning(scene))
-    fmt::print("warning     {}\n", *warning);
+  for (const std::string& warning : camera_warnings(scene)) fmt::print("warning     {}\n", warning);
   fmt::print("background  {:.3g} {:.3g} {:.3g}\n", scene.background[0], scene.background[1],
              scene.background[2]);
 }

@@ -200,39 +200,46 @@ bool set_pinhole(Camera& camera) {
   return pinhole.has_value();
 }
 
-}  // namespace
-
-bool is_scene(const fs::path& path) {
-  return detect_format(path) != SceneFormat::None;
-}
-
-void require_training_views(const Scene& scene) {
-  if (scene.split(Split::Train).empty())
-    fail_file(scene.root, fmt::format("no training views: all {} images are test views ({})",
-                                      scene.cameras.size(),
-                                      scene.format == "blender"
-                                          ? "NeRF-Synthetic scenes train on transforms_train.json"
-                                          : "this format holds out every --test-every-th image"));
-}
-
-void require_trainable_views(const Scene& scene) {
-  require_training_views(scene);
-  // 3DGS scales its position learning rate and densification by the spread of the training
-  // cameras: views from one position give it none, and no position would be optimized.
-  const SceneNormalization sphere = scene.normalization();
-  if (sphere.radius > 1e-9 * (1 + sphere.center.norm())) {
-    if (const std::optional<std::string> warning = camera_spread_warning(scene))
-      spdlog::warn("{}: {}", scene.root.string(), *warning);
-    return;
+// What the training cameras look at: the SfM points (a subsample, so that the check stays cheap on
+// millions), else the point their optical axes meet. Empty when neither is known.
+std::vector<Vec3> looked_at_points(const Scene& scene, std::string& what) {
+  constexpr size_t kMostPoints = 4096;
+  const std::vector<Vec3>& points = scene.points.positions;
+  std::vector<Vec3> targets;
+  if (!points.empty()) {
+    what = "the scene's points";
+    const size_t step = (points.size() + kMostPoints - 1) / kMostPoints;
+    for (size_t i = 0; i < points.size(); i += step) targets.push_back(points[i]);
+  } else if (const std::optional<Vec3> focus = focus_point(scene.split(Split::Train))) {
+    what = "the point their optical axes meet";
+    targets.push_back(*focus);
   }
-  const size_t count = scene.split(Split::Train).size();
-  const std::string views = count == 1
-                                ? "a single training view, at"
-                                : fmt::format("all {} training views at one position,", count);
-  fail_file(scene.root, fmt::format("{} ({:.6g}, {:.6g}, {:.6g}): Gaussian splatting needs views "
-                                    "from different positions, to see depth and to take the "
-                                    "scene's scale from their spread",
-                                    views, sphere.center.x, sphere.center.y, sphere.center.z));
+  return targets;
+}
+
+// Most training cameras with what they look at behind them: a pose convention mistaken (a
+// transforms.json written with OpenCV's axes), whose views would show nothing to learn from.
+std::optional<std::string> camera_facing_warning(const Scene& scene) {
+  std::string what;
+  const std::vector<Vec3> targets = looked_at_points(scene, what);
+  const std::vector<const Camera*> cameras = scene.split(Split::Train);
+  if (targets.empty()) return std::nullopt;
+  size_t away = 0;
+  for (const Camera* camera : cameras) {
+    std::vector<double> depths;
+    for (const Vec3& target : targets)
+      depths.push_back((camera->rotation * target + camera->translation).z);
+    away += median(depths) <= 0;
+  }
+  if (2 * away <= cameras.size()) return std::nullopt;
+  return fmt::format(
+      "{} of the {} training cameras face away from {}: their views would show none of it, and "
+      "training would learn nothing{}",
+      away, cameras.size(), what,
+      scene.format == "colmap"
+          ? ""
+          : " (transforms files hold camera-to-world matrices with OpenGL's axes, x right, y up, "
+            "z backward: one written with OpenCV's, z forward, turns every camera around)");
 }
 
 std::optional<std::string> camera_spread_warning(const Scene& scene) {
@@ -255,6 +262,49 @@ std::optional<std::string> camera_spread_warning(const Scene& scene) {
       "({:.3g}): views from nearly one position see little parallax, and 3DGS's position "
       "learning rate and densification sizes, which scale with that spread, will be tiny",
       cameras.size(), spread, 100 * spread / depth, depth);
+}
+
+}  // namespace
+
+bool is_scene(const fs::path& path) {
+  return detect_format(path) != SceneFormat::None;
+}
+
+void require_training_views(const Scene& scene) {
+  if (scene.split(Split::Train).empty())
+    fail_file(scene.root, fmt::format("no training views: all {} images are test views ({})",
+                                      scene.cameras.size(),
+                                      scene.format == "blender"
+                                          ? "NeRF-Synthetic scenes train on transforms_train.json"
+                                          : "this format holds out every --test-every-th image"));
+}
+
+void require_trainable_views(const Scene& scene) {
+  require_training_views(scene);
+  // 3DGS scales its position learning rate and densification by the spread of the training
+  // cameras: views from one position give it none, and no position would be optimized.
+  const SceneNormalization sphere = scene.normalization();
+  if (sphere.radius > 1e-9 * (1 + sphere.center.norm())) {
+    for (const std::string& warning : camera_warnings(scene))
+      spdlog::warn("{}: {}", scene.root.string(), warning);
+    return;
+  }
+  const size_t count = scene.split(Split::Train).size();
+  const std::string views = count == 1
+                                ? "a single training view, at"
+                                : fmt::format("all {} training views at one position,", count);
+  fail_file(scene.root, fmt::format("{} ({:.6g}, {:.6g}, {:.6g}): Gaussian splatting needs views "
+                                    "from different positions, to see depth and to take the "
+                                    "scene's scale from their spread",
+                                    views, sphere.center.x, sphere.center.y, sphere.center.z));
+}
+
+std::vector<std::string> camera_warnings(const Scene& scene) {
+  std::vector<std::string> warnings;
+  for (const std::optional<std::string>& warning :
+       {camera_facing_warning(scene), camera_spread_warning(scene)})
+    if (warning) warnings.push_back(*warning);
+  return warnings;
 }
 
 fs::path scene_folder(const fs::path& root) {

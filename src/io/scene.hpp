@@ -61,10 +61,11 @@ bool is_scene(const std::filesystem::path& path);
 void require_training_views(const Scene& scene);
 
 // The same, and also when every training view is taken from one position: nothing to train on.
-// Logs camera_spread_warning's text when there is one.
+// Logs camera_warnings' texts.
 void require_trainable_views(const Scene& scene);
 
-// A warning when the training cameras are that close together, else nothing.
-std::optional<std::string> camera_spread_warning(const Scene& scene);
+// What is suspect in the training cameras, one text each: most of them facing away from what
+// they look at (a pose convention mistaken), or all nearly at one position (little parallax).
+std::vector<std::string> camera_warnings(const Scene& scene);
 
 }  // namespace iesrgs

@@ -182,19 +182,47 @@ Scene cameras_facing_points(double spread, double depth) {
 }
 
 TEST(Scene, CamerasNearlyAtOnePositionAreWarnedAbout) {
-  const std::optional<std::string> warning = camera_spread_warning(cameras_facing_points(0.05, 10));
-  ASSERT_TRUE(warning.has_value());
-  EXPECT_TRUE(contains(*warning, "the 3 training cameras lie within 0.05 of their center, 0.5 %"))
-      << *warning;
+  const std::vector<std::string> warnings = camera_warnings(cameras_facing_points(0.05, 10));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_TRUE(
+      contains(warnings[0], "the 3 training cameras lie within 0.05 of their center, 0.5 %"))
+      << warnings[0];
   require_trainable_views(cameras_facing_points(0.05, 10));  // warned about, not refused
   // A forward-facing capture spreads over a few percent of its depth.
-  EXPECT_FALSE(camera_spread_warning(cameras_facing_points(0.5, 10)).has_value());
+  EXPECT_TRUE(camera_warnings(cameras_facing_points(0.5, 10)).empty());
 }
 
 TEST(Scene, CamerasAroundAnObjectAreNotWarnedAbout) {
   TempDir dir;
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 4, 1});
-  EXPECT_FALSE(camera_spread_warning(load_scene(dir / "scene")).has_value());
+  EXPECT_TRUE(camera_warnings(load_scene(dir / "scene")).empty());
+}
+
+// Poses in OpenCV's convention read as OpenGL's turn every camera around: what they look at lies
+// behind them, and training would learn nothing.
+TEST(Scene, CamerasFacingAwayAreWarnedAbout) {
+  const std::vector<std::string> behind = camera_warnings(cameras_facing_points(0.5, -10));
+  ASSERT_EQ(behind.size(), 1u);
+  EXPECT_TRUE(contains(behind[0], "3 of the 3 training cameras face away from the scene's points"))
+      << behind[0];
+
+  TempDir dir;
+  synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 4, 1});
+  const auto json_path = dir / "scene" / "transforms_train.json";
+  nlohmann::json transforms = nlohmann::json::parse(read_file(json_path));
+  for (nlohmann::json& frame : transforms["frames"])
+    for (int row = 0; row < 3; ++row)
+      for (int column : {1, 2})  // y and z axes negated: OpenCV's convention
+        frame["transform_matrix"][row][column] =
+            -frame["transform_matrix"][row][column].get<double>();
+  write_file_atomically(json_path, transforms.dump());
+  const std::vector<std::string> turned = camera_warnings(load_scene(dir / "scene"));
+  ASSERT_EQ(turned.size(), 1u);
+  EXPECT_TRUE(contains(turned[0],
+                       "4 of the 4 training cameras face away from the point their "
+                       "optical axes meet: their views would show none of it"))
+      << turned[0];
+  EXPECT_TRUE(contains(turned[0], "one written with OpenCV's, z forward")) << turned[0];
 }
 
 TEST(Scene, AFieldOfViewOf180DegreesIsRefused) {
