@@ -191,7 +191,6 @@ void run_eval(const EvalArgs& args) {
   GroundTruth truth(args, options);
   const eval::LoadedLpips lpips = eval::load_default_lpips(args.lpips);
   eval::MetricsReport report;
-  report.lpips_status = lpips.status;
   const std::vector<std::filesystem::path> files = render_files(args.renders);
   for (size_t i = 0; i < files.size(); ++i) {
     const std::string name = files[i].stem().string();
@@ -208,6 +207,7 @@ void run_eval(const EvalArgs& args) {
   }
   // A mean over part of a split is not the split's score: say so, in the report and next to the
   // numbers.
+  report.lpips_status = eval::lpips_status(lpips, report.views);
   report.unscored = truth.unscored(report.views);
   const std::vector<std::string>& unscored = report.unscored;
   eval::write_report(base, report);

@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -69,8 +70,18 @@ double ssim(const Image& image, const Image& reference) {
 ViewMetrics measure_view(const std::string& name, const Image& render, const Image& reference,
                          const Lpips* lpips) {
   std::optional<double> perceptual;
-  if (lpips) perceptual = lpips->distance(to_tensor(render), to_tensor(reference));
+  if (lpips && std::min(render.width, render.height) >= lpips->min_size())
+    perceptual = lpips->distance(to_tensor(render), to_tensor(reference));
   return {name, psnr(render, reference), ssim(render, reference), perceptual};
+}
+
+std::string lpips_status(const LoadedLpips& lpips, const std::vector<ViewMetrics>& views) {
+  const bool every_view = std::all_of(
+      views.begin(), views.end(), [](const ViewMetrics& view) { return view.lpips.has_value(); });
+  if (!lpips.get() || every_view) return lpips.status;
+  const int size = lpips.get()->min_size();
+  return fmt::format("{}: not computed for views under {}x{} pixels, the network's smallest",
+                     lpips.status, size, size);
 }
 
 ViewMetrics MetricsReport::mean() const {

@@ -23,10 +23,15 @@ struct ViewMetrics {
 };
 
 class Lpips;
+struct LoadedLpips;
 
-// Scores of one render against its reference (both RGB of the same size); LPIPS when given.
+// Scores of one render against its reference (both RGB of the same size); LPIPS when given and
+// the images are not smaller than its network takes.
 ViewMetrics measure_view(const std::string& name, const Image& render, const Image& reference,
                          const Lpips* lpips);
+
+// What a report says of LPIPS: the net's name, or why some or all of `views` have none.
+std::string lpips_status(const LoadedLpips& lpips, const std::vector<ViewMetrics>& views);
 
 struct MetricsReport {
   std::vector<ViewMetrics> views;

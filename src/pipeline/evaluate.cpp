@@ -13,12 +13,12 @@ Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector
       render_views_recorded(dir, model, cameras, background, 1.0, {{"split", "test"}});
   if (!truth) return evaluation;
   eval::MetricsReport& report = evaluation.report;
-  report.lpips_status = lpips.status;
   for (const Camera& camera : cameras) {
     const Image render = to_float(read_image8(rendered_view_files(dir, camera.name).rgb));
     report.views.push_back(
         eval::measure_view(camera.name, render, *truth->rgb(camera), lpips.get()));
   }
+  report.lpips_status = eval::lpips_status(lpips, report.views);
   eval::write_report(dir / "metrics", report);
   return evaluation;
 }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "eval/metrics.hpp"
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "priors/state_dict.hpp"
@@ -179,6 +180,25 @@ TEST(Lpips, RunsAtItsMinimumSize) {
     EXPECT_GT(distance, 0.f) << lpips_net_name(net);  // a mirrored noise image differs
     EXPECT_TRUE(std::isfinite(distance)) << lpips_net_name(net);
   }
+}
+
+// A view smaller than the network takes still gets PSNR and SSIM; the report says why it has no
+// LPIPS, and the mean has none.
+TEST(Lpips, ViewsUnderItsSizeAreScoredWithoutIt) {
+  if (!fs::exists(kHeads)) GTEST_SKIP() << "LPIPS heads not found: " << kHeads;
+  LoadedLpips loaded{stand_in_lpips(LpipsNet::Alex), "alex"};
+  const int size = loaded.get()->min_size();
+  Image small(size - 1, size + 5, 3), large(size, size, 3);
+  for (float& value : small.data) value = 0.5f;
+  for (float& value : large.data) value = 0.5f;
+  const std::vector<ViewMetrics> views = {measure_view("large", large, large, loaded.get()),
+                                          measure_view("small", small, small, loaded.get())};
+  EXPECT_TRUE(views[0].lpips.has_value());
+  EXPECT_FALSE(views[1].lpips.has_value());
+  EXPECT_TRUE(std::isinf(views[1].psnr));
+  EXPECT_EQ(lpips_status(loaded, views),
+            "alex: not computed for views under 31x31 pixels, the network's smallest");
+  EXPECT_EQ(lpips_status(loaded, {views[0]}), "alex");
 }
 
 TEST(Lpips, ErrorsNameTheCheckpointAndTheEntry) {
