@@ -1,5 +1,7 @@
 #include "io/resize.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -151,13 +153,16 @@ void vertical_pass(const typename Arith::Image& in, const Kernel<Arith>& kernel,
                    typename Arith::Image& out) {
   using Sample = typename Arith::Sample;
   const size_t row_size = size_t(in.width) * in.channels;
+  // One row of sums per thread, allocated here: out of memory inside the region would end the
+  // program.
+  std::vector<typename Arith::Sum> all_sums(row_size * omp_get_max_threads());
 #pragma omp parallel if (out.data.size() * kernel.stride > kMinParallelWork)
   {
-    std::vector<typename Arith::Sum> sums(row_size);
+    typename Arith::Sum* sums = all_sums.data() + row_size * omp_get_thread_num();
 #pragma omp for schedule(static)
     for (int y = 0; y < out.height; ++y) {
       const auto* w = kernel.taps(y);
-      std::fill(sums.begin(), sums.end(), Arith::kStart);
+      std::fill(sums, sums + row_size, Arith::kStart);
       for (int k = 0; k < kernel.length[y]; ++k) {
         const Sample* src = &in.data[size_t(kernel.first[y] + k) * row_size];
         for (size_t i = 0; i < row_size; ++i) sums[i] += src[i] * w[k];

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <type_traits>
 #include <vector>
 
@@ -93,12 +94,23 @@ std::vector<PixelBox> bands(const ImageShape& shape) {
 }
 
 // body(i, boxes[i]) for every box, in parallel; bands take one thread each, tiles are many and
-// uneven, so they go to whichever thread is free.
+// uneven, so they go to whichever thread is free. A body allocates its rows' buffers: an exception
+// cannot leave an OpenMP region (out of memory would end the program there), so the first one is
+// kept and thrown again after it.
 template <typename Body>
 void for_each_box(const std::vector<PixelBox>& boxes, Body&& body) {
   const int64_t count = int64_t(boxes.size());
+  std::exception_ptr error;
 #pragma omp parallel for schedule(dynamic)
-  for (int64_t i = 0; i < count; ++i) body(i, boxes[i]);
+  for (int64_t i = 0; i < count; ++i) {
+    try {
+      body(i, boxes[i]);
+    } catch (...) {
+#pragma omp critical(ssim_box_error)
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
 }
 
 // Offset of row r of channel c in a CHW array.
