@@ -25,8 +25,28 @@
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_ONLY_PNG
 #define STBI_ONLY_JPEG
-#define STBI_MALLOC(size) std::calloc(1, size)
-#define STBI_REALLOC(pointer, size) std::realloc(pointer, size)
+namespace {
+
+// Whether one of stb's allocations failed in this thread since the decode began: stb gives no
+// reason for some (its first zlib buffer), and would then leave another decoder's stale one.
+thread_local bool stb_out_of_memory = false;
+
+void* stb_allocate(size_t size) {
+  void* pointer = std::calloc(1, size);
+  stb_out_of_memory |= pointer == nullptr;
+  return pointer;
+}
+
+void* stb_reallocate(void* pointer, size_t size) {
+  void* moved = std::realloc(pointer, size);
+  stb_out_of_memory |= moved == nullptr && size > 0;
+  return moved;
+}
+
+}  // namespace
+
+#define STBI_MALLOC(size) stb_allocate(size)
+#define STBI_REALLOC(pointer, size) stb_reallocate(pointer, size)
 #define STBI_FREE(pointer) std::free(pointer)
 #include <stb/stb_image.h>
 
@@ -58,6 +78,7 @@ std::string unreadable(std::string_view bytes, std::string_view reason) {
 }
 
 std::string decode_problem(std::string_view bytes) {
+  if (stb_out_of_memory) return "out of memory while decoding it";
   const char* reason = stbi_failure_reason();
   if (reason && std::string_view(reason) == "too large")  // or damaged: a header's size is read
     return "too large to decode: more than 16777216 pixels a side or 2 GiB of pixels, or its "
@@ -184,6 +205,7 @@ ImageHeader read_image_header(const fs::path& path) {
   const std::string_view bytes = file.bytes();
   ImageHeader header;
   int channels = 0;
+  stb_out_of_memory = false;
   if (!stbi_info_from_memory(stb_bytes(bytes, path), int(bytes.size()), &header.width,
                              &header.height, &channels))
     fail_file(path, decode_problem(bytes));
@@ -205,12 +227,17 @@ Image8 read_image8(const fs::path& path) {
     fail_file(path, fmt::format("damaged: its header claims {}x{} pixels, more than its {} bytes "
                                 "can hold",
                                 w, h, bytes.size()));
+  stb_out_of_memory = false;
   std::unique_ptr<stbi_uc, void (*)(void*)> pixels(
       stbi_load_from_memory(data, int(bytes.size()), &w, &h, &c, 0), stbi_image_free);
   if (!pixels) fail_file(path, decode_problem(bytes));
-  Image8 image(w, h, c);
-  std::memcpy(image.data.data(), pixels.get(), image.data.size());
-  return image;
+  try {
+    Image8 image(w, h, c);
+    std::memcpy(image.data.data(), pixels.get(), image.data.size());
+    return image;
+  } catch (const std::bad_alloc&) {
+    fail_file(path, "out of memory while decoding it");
+  }
 }
 
 Image to_float(const Image8& image) {

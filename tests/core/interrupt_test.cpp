@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "core/error.hpp"
-#include "support/ended_by.hpp"
+#include "support/child_process.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 

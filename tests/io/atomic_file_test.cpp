@@ -8,9 +8,8 @@
 #include <fstream>
 
 #include "core/interrupt.hpp"
-#include "support/ended_by.hpp"
+#include "support/child_process.hpp"
 #include "support/expect_error.hpp"
-#include "support/file_size_limit.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs {

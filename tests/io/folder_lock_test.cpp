@@ -7,7 +7,7 @@
 
 #include "core/interrupt.hpp"
 #include "io/atomic_file.hpp"
-#include "support/ended_by.hpp"
+#include "support/child_process.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 

@@ -3,6 +3,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
+#include "support/child_process.hpp"
 #include "support/expect_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -146,6 +147,27 @@ TEST(Image, CorruptFilesAreNamed) {
 }
 
 // A flipped byte of the pixel data still inflates, into other pixels: the chunk's CRC tells.
+// 0 when decoding `png` fails, out of memory, with a message saying so.
+int decode_out_of_memory(const std::filesystem::path& png) {
+  const std::string message = error_message([&] { read_image8(png); });
+  return message == png.string() + ": out of memory while decoding it" ? 0 : 1;
+}
+
+// Out of memory while decoding is said as such: stb gives its zlib buffer's failure no reason,
+// which left a JPEG check's "no SOI" to call the PNG unreadable.
+TEST(Image, OutOfMemoryWhileDecodingIsNamed) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer's allocator ends the process rather than fail an allocation";
+#endif
+  TempDir dir;
+  const auto png = dir / "large.png";
+  write_png(png, Image8(4096, 4096, 3));  // 48 MiB of pixels in a small file
+  EXPECT_EQ(
+      testing::exit_status_with_memory_to_spare(8 << 20, [&] { return decode_out_of_memory(png); }),
+      0);
+  EXPECT_EQ(read_image8(png).width, 4096);
+}
+
 TEST(Image, APngWhoseDataFailsItsCrcIsDamaged) {
   TempDir dir;
   write_png(dir / "ok.png", gradient(64, 64, 3));

@@ -10,8 +10,8 @@
 
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
+#include "support/child_process.hpp"
 #include "support/expect_error.hpp"
-#include "support/file_size_limit.hpp"
 #include "support/temp_dir.hpp"
 
 namespace iesrgs::train {
