@@ -1,8 +1,12 @@
 #include "core/memory.hpp"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <fstream>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #ifdef IESRGS_WITH_CUDA
@@ -13,8 +17,10 @@ namespace iesrgs {
 
 namespace {
 
+namespace fs = std::filesystem;
+
 // The value of `key` in a /proc file of "key: value kB" lines, in bytes; -1 when absent.
-int64_t proc_kib_field(const char* file, const std::string& key) {
+int64_t proc_kib_field(const fs::path& file, const std::string& key) {
   std::ifstream status(file);
   std::string name;
   while (status >> name) {
@@ -28,6 +34,65 @@ int64_t proc_kib_field(const char* file, const std::string& key) {
   return -1;
 }
 
+// The first number in `file`, -1 when there is none ("max", an absent file).
+int64_t file_number(const fs::path& file) {
+  std::ifstream in(file);
+  int64_t value = -1;
+  return in >> value ? value : -1;
+}
+
+// The value of `key` in a cgroup's memory.stat ("key value" lines, in bytes), 0 when absent.
+int64_t stat_field(const fs::path& file, const std::string& key) {
+  std::ifstream in(file);
+  std::string name;
+  int64_t value = 0;
+  while (in >> name >> value)
+    if (name == key) return value;
+  return 0;
+}
+
+// The cgroup path of this process in one hierarchy of /proc/self/cgroup ("id:controllers:path"):
+// v2's line has id 0 and no controllers, v1's memory hierarchy names "memory" among them.
+std::optional<std::string> cgroup_path(const fs::path& proc_self, bool v2) {
+  std::ifstream in(proc_self / "cgroup");
+  for (std::string line; std::getline(in, line);) {
+    const size_t first = line.find(':'), second = line.find(':', first + 1);
+    if (first == std::string::npos || second == std::string::npos) continue;
+    const std::string controllers = "," + line.substr(first + 1, second - first - 1) + ",";
+    const bool match = v2 ? line.compare(0, first, "0") == 0 && controllers == ",,"
+                          : controllers.find(",memory,") != std::string::npos;
+    if (match) return line.substr(second + 1);
+  }
+  return std::nullopt;
+}
+
+// The files of a cgroup hierarchy's memory controller: v2's or v1's.
+struct CgroupFiles {
+  const char *limit, *usage, *inactive_file;
+};
+
+// The least memory left at any level of a cgroup hierarchy, from the process's group up to `root`
+// (a container sees its own group as the root), -1 when no level sets a limit.
+int64_t cgroup_memory_left(const fs::path& root, const std::string& path,
+                           const CgroupFiles& names) {
+  std::error_code ec;
+  fs::path group = (root / fs::path(path).relative_path()).lexically_normal();
+  if (!fs::is_directory(group, ec)) group = root;
+  int64_t least = -1;
+  constexpr int64_t kNoLimit = int64_t(1) << 60;  // v1 writes "no limit" as about 2^63
+  for (fs::path level = group;; level = level.parent_path()) {
+    const int64_t limit = file_number(level / names.limit);
+    if (limit >= 0 && limit < kNoLimit) {
+      const int64_t used =
+          file_number(level / names.usage) - stat_field(level / "memory.stat", names.inactive_file);
+      const int64_t left = std::max<int64_t>(0, limit - std::max<int64_t>(0, used));
+      least = least < 0 ? left : std::min(least, left);
+    }
+    if (level == root || !level.has_relative_path() || level == level.parent_path()) break;
+  }
+  return least;
+}
+
 double gib(int64_t bytes) {
   return double(bytes) / double(int64_t(1) << 30);
 }
@@ -38,8 +103,37 @@ int64_t peak_memory_bytes() {
   return std::max<int64_t>(0, proc_kib_field("/proc/self/status", "VmHWM:"));
 }
 
+int64_t resident_memory_bytes() {
+  return std::max<int64_t>(0, proc_kib_field("/proc/self/status", "VmRSS:"));
+}
+
+int64_t limited_memory_bytes(const fs::path& cgroup_mount, const fs::path& proc_self) {
+  std::vector<int64_t> left;
+  if (const auto path = cgroup_path(proc_self, true))
+    left.push_back(
+        cgroup_memory_left(cgroup_mount, *path, {"memory.max", "memory.current", "inactive_file"}));
+  if (const auto path = cgroup_path(proc_self, false))
+    left.push_back(cgroup_memory_left(
+        cgroup_mount / "memory", *path,
+        {"memory.limit_in_bytes", "memory.usage_in_bytes", "total_inactive_file"}));
+  rlimit address_space{};
+  if (::getrlimit(RLIMIT_AS, &address_space) == 0 && address_space.rlim_cur != RLIM_INFINITY) {
+    const int64_t mapped = proc_kib_field(proc_self / "status", "VmSize:");
+    if (mapped >= 0) left.push_back(std::max<int64_t>(0, int64_t(address_space.rlim_cur) - mapped));
+  }
+  int64_t least = -1;
+  for (const int64_t bytes : left)
+    if (bytes >= 0) least = least < 0 ? bytes : std::min(least, bytes);
+  return least;
+}
+
 int64_t available_memory_bytes(torch::Device device) {
-  if (device.is_cpu()) return proc_kib_field("/proc/meminfo", "MemAvailable:");
+  if (device.is_cpu()) {
+    const int64_t machine = proc_kib_field("/proc/meminfo", "MemAvailable:");
+    const int64_t limited = limited_memory_bytes();
+    if (machine < 0 || limited < 0) return std::max(machine, limited);
+    return std::min(machine, limited);
+  }
 #ifdef IESRGS_WITH_CUDA
   if (device.is_cuda()) return cuda::free_memory_bytes();
 #endif

@@ -2,12 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 
+#include "support/child_process.hpp"
 #include "support/cuda_device.hpp"
 #include "support/expect_error.hpp"
+#include "support/temp_dir.hpp"
 
 namespace iesrgs {
 namespace {
@@ -39,12 +43,59 @@ int64_t mem_available_bytes() {
   return -1;
 }
 
-TEST(Memory, TheCpuByDefaultIsMemAvailable) {
-  const int64_t expected = mem_available_bytes();
-  ASSERT_GT(expected, 0) << "no MemAvailable in /proc/meminfo";
+TEST(Memory, TheCpuByDefaultIsMemAvailableOrTheLimitBelowIt) {
+  const int64_t machine = mem_available_bytes();
+  ASSERT_GT(machine, 0) << "no MemAvailable in /proc/meminfo";
+  const int64_t limited = limited_memory_bytes();
+  const int64_t expected = limited >= 0 ? std::min(machine, limited) : machine;
   // Other processes move it between the reads, by far less than a tenth.
   EXPECT_NEAR(double(available_memory_bytes(torch::kCPU)), double(expected), 0.1 * expected);
   EXPECT_NEAR(double(available_memory_bytes()), double(expected), 0.1 * expected);
+}
+
+// A cgroup's limit, as a container or a systemd unit sets it: what its group may still take,
+// counting its reclaimable file cache as free, and the least of its levels'.
+TEST(Memory, ACgroupsLimitIsWhatIsLeftBelowIt) {
+  testing::TempDir dir;
+  const auto write = [&](const std::filesystem::path& file, const std::string& text) {
+    std::filesystem::create_directories(file.parent_path());
+    std::ofstream(file) << text;
+  };
+  constexpr int64_t kMiB = 1 << 20;
+  // v2: the unit's own limit, and its parent's, which leaves less.
+  write(dir / "proc" / "cgroup", "0::/outer/unit\n");
+  write(dir / "cg" / "outer" / "unit" / "memory.max", std::to_string(800 * kMiB) + "\n");
+  write(dir / "cg" / "outer" / "unit" / "memory.current", std::to_string(300 * kMiB) + "\n");
+  write(dir / "cg" / "outer" / "unit" / "memory.stat",
+        "anon 1\nfile 2\ninactive_file " + std::to_string(100 * kMiB) + "\n");
+  EXPECT_EQ(limited_memory_bytes(dir / "cg", dir / "proc"), 600 * kMiB);
+  write(dir / "cg" / "outer" / "memory.max", std::to_string(500 * kMiB) + "\n");
+  write(dir / "cg" / "outer" / "memory.current", std::to_string(400 * kMiB) + "\n");
+  EXPECT_EQ(limited_memory_bytes(dir / "cg", dir / "proc"), 100 * kMiB);
+  write(dir / "cg" / "outer" / "memory.max", "max\n");
+  write(dir / "cg" / "outer" / "unit" / "memory.max", "max\n");
+  EXPECT_EQ(limited_memory_bytes(dir / "cg", dir / "proc"), -1);
+
+  // v1, seen from inside a container: its group is the hierarchy's root.
+  write(dir / "proc" / "cgroup", "4:memory:/docker/abc\n0::/\n");
+  write(dir / "cg" / "memory" / "memory.limit_in_bytes", std::to_string(2048 * kMiB) + "\n");
+  write(dir / "cg" / "memory" / "memory.usage_in_bytes", std::to_string(1024 * kMiB) + "\n");
+  write(dir / "cg" / "memory" / "memory.stat",
+        "cache 1\ntotal_inactive_file " + std::to_string(24 * kMiB) + "\n");
+  EXPECT_EQ(limited_memory_bytes(dir / "cg", dir / "proc"), 1048 * kMiB);
+  write(dir / "cg" / "memory" / "memory.limit_in_bytes", "9223372036854771712\n");
+  EXPECT_EQ(limited_memory_bytes(dir / "cg", dir / "proc"), -1);
+}
+
+// ulimit -v: what is left of the address space.
+TEST(Memory, AnAddressSpaceLimitIsWhatIsLeftBelowIt) {
+  EXPECT_EQ(testing::exit_status_with_memory_to_spare(
+                64 << 20,
+                [] {
+                  const int64_t left = available_memory_bytes();
+                  return left > (48 << 20) && left <= (64 << 20) ? 0 : 1;
+                }),
+            0);
 }
 
 TEST(Memory, GpuMemoryIsTheDevicesFreeMemory) {
