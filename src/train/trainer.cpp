@@ -344,8 +344,8 @@ void Trainer::warn_memory_cap(int64_t iteration, int64_t cap, int64_t held_back)
   if (memory_capped_ || (config_.max_gaussians > 0 && cap >= config_.max_gaussians)) return;
   memory_capped_ = true;
   spdlog::warn(
-      "iteration {}: densification stops at {} Gaussians, as many as the available memory holds "
-      "({} more were due to clone or split)",
+      "iteration {}: densification held to {} Gaussians, as many as the available memory holds "
+      "({} more were due to clone or split); from here it grows only as memory allows",
       iteration, cap, held_back);
 }
 
@@ -356,7 +356,14 @@ int64_t Trainer::densify_cap() const {
   const int64_t configured =
       config_.max_gaussians > 0 ? config_.max_gaussians : std::numeric_limits<int64_t>::max();
   if (available < 0) return configured;
-  return std::min(configured, model_.size() + available / kBytesPerGaussian);
+  // A training step's buffers are freed between steps: what the process has held above its
+  // present size (on the CPU, where that is measured) is taken again by the next step.
+  const int64_t step_buffers =
+      device_.is_cpu() ? std::max<int64_t>(0, peak_memory_bytes() - resident_memory_bytes()) : 0;
+  // Each new Gaussian counted twice: densification's copies of the parameters and moments, and
+  // the allocator's slack, come on top of its steady cost.
+  const int64_t growth = std::max<int64_t>(0, available - step_buffers) / (2 * kBytesPerGaussian);
+  return std::min(configured, model_.size() + growth);
 }
 
 void Trainer::fail_diverged(int64_t iteration, double loss) const {
@@ -425,6 +432,9 @@ TrainSummary Trainer::run() {
       break;
     }
   }
+  // The finished run's moments are in its checkpoint: freed for the model files written next,
+  // which copy the model (near the end of the memory, this is the peak).
+  if (iteration_ == config_.iterations) optimizer_.reset();
   summary.seconds = training_seconds();
   summary.iterations = iteration_;
   summary.iterations_per_second = summary.seconds > 0 ? double(iteration_) / summary.seconds : 0;
