@@ -69,11 +69,12 @@ SplatCloud viewer_cloud(const SplatCloud& cloud, const std::filesystem::path& pa
   }
   if (keep.size() == baked.size()) return baked;
   if (keep.empty())
-    fail_file(path, fmt::format("no Gaussian can be drawn ({}, and so have all the others)",
+    fail_file(path, fmt::format("not written: no Gaussian of the model can be drawn ({}, and so "
+                                "have all the others)",
                                 first_left_out));
   // As gsplat's export does; renders cull such Gaussians too.
-  spdlog::warn("{}: left out {} of {} Gaussians that no viewer can draw ({})", path.string(),
-               baked.size() - keep.size(), baked.size(), first_left_out);
+  spdlog::warn("{}: left out {} of the model's {} Gaussians, which no viewer can draw ({})",
+               path.string(), baked.size() - keep.size(), baked.size(), first_left_out);
   return select(baked, keep);
 }
 

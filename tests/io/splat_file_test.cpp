@@ -94,8 +94,9 @@ TEST(SplatFile, UndrawableGaussiansAreLeftOutAndMalformedCloudsWriteNothing) {
   cloud.log_scales[0] = 100;  // finite, but not once exponentiated into a float
   cloud.rotations[4] = cloud.rotations[5] = cloud.rotations[6] = cloud.rotations[7] = 0;
   const std::string none = error_message([&] { write_splat(dir / "a.splat", cloud); });
-  EXPECT_TRUE(
-      contains(none, "a.splat: no Gaussian can be drawn (Gaussian 0 has a scale that is no finite"))
+  EXPECT_TRUE(contains(none,
+                       "a.splat: not written: no Gaussian of the model can be drawn (Gaussian 0 "
+                       "has a scale that is no finite"))
       << none;
   cloud = two_gaussians();
   cloud.positions[0] = 1e30f;  // far, but a valid position

@@ -123,7 +123,9 @@ TEST(SpzFile, UnstorableCloudsAreErrorsAndWriteNothing) {
   cloud.sh_degree = 1;
   cloud.sh_rest = {0, 0, 0, 0, NAN, 0, 0, 0, 0};
   const std::string nan = error_message([&] { write_spz(dir / "a.spz", cloud); });
-  EXPECT_TRUE(contains(nan, "a.spz: no Gaussian can be drawn (Gaussian 0 has a non-finite colour"))
+  EXPECT_TRUE(contains(nan,
+                       "a.spz: not written: no Gaussian of the model can be drawn (Gaussian 0 has "
+                       "a non-finite colour"))
       << nan;
   cloud = one_gaussian();
   cloud.positions[0] = 1e7f;
