@@ -133,6 +133,8 @@ Scene read_any_format(const fs::path& root, const SceneOptions& options) {
       break;
   }
   std::error_code ec;
+  if (fs::exists(root, ec) && !fs::is_directory(root, ec))
+    fail_file(root, "not a scene: give a scene's folder, or its transforms .json file");
   if (!fs::is_directory(root, ec)) fail_file(root, "scene directory not found");
   fail_file(root,
             "no scene found (looked for sparse/0/, transforms_train.json, transforms_test.json, "
@@ -170,23 +172,28 @@ void require_unique_names(const Scene& scene) {
 }
 
 // A pinhole camera sees less than 180 degrees: a focal length that makes it nearly that wide is a
-// unit mistake, and would project Gaussians to the edge of infinity.
+// unit mistake, and would project Gaussians to the edge of infinity. An optical axis more than the
+// image's own size away from it is a unit or key mix-up, not a lens: such a view shows the model
+// nowhere, and training on it "succeeds" on a blank render.
 void require_pinhole_view(const Camera& camera) {
   const Intrinsics& k = camera.stored;
-  const double widest = kWidestFieldOfView * kPi / 180;
-  const bool finite =
-      std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) && std::isfinite(k.cy);
-  // An optical axis more than the image's own size away from it is a unit or key mix-up, not a
-  // lens: such a view shows the model nowhere, and training on it "succeeds" on a blank render.
-  const bool centred =
-      k.cx >= -k.width && k.cx <= 2.0 * k.width && k.cy >= -k.height && k.cy <= 2.0 * k.height;
-  if (finite && centred && k.fov_x() < widest && k.fov_y() < widest) return;
-  fail_file(camera.image_path,
-            fmt::format("focal lengths {:.6g}, {:.6g} px and principal point {:.6g}, {:.6g} for "
-                        "a {}x{} image: a pinhole camera needs finite values, a field of view "
-                        "under {} degrees and its principal point within an image's size of the "
-                        "image",
-                        k.fx, k.fy, k.cx, k.cy, k.width, k.height, kWidestFieldOfView));
+  const std::string intrinsics = fmt::format(
+      "its camera's focal lengths {:.6g}, {:.6g} px and principal point {:.6g}, "
+      "{:.6g} for a {}x{} image",
+      k.fx, k.fy, k.cx, k.cy, k.width, k.height);
+  if (!(std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) && std::isfinite(k.cy)))
+    fail_file(camera.image_path, intrinsics + ": a pinhole camera needs finite values");
+  const double widest = std::max(k.fov_x(), k.fov_y()) * 180 / kPi;
+  if (!(widest < kWidestFieldOfView))
+    fail_file(camera.image_path,
+              fmt::format("{} make a field of view of {:.4g} degrees: a pinhole camera sees less "
+                          "than {} (a focal length in other units?)",
+                          intrinsics, widest, kWidestFieldOfView));
+  if (!(k.cx >= -k.width && k.cx <= 2.0 * k.width && k.cy >= -k.height && k.cy <= 2.0 * k.height))
+    fail_file(camera.image_path,
+              intrinsics +
+                  ": the principal point lies more than the image's own size outside "
+                  "it, so the view would show nothing its image does");
 }
 
 // The pinhole model a view is rendered with: the image's own when it has no lens distortion, else

@@ -233,7 +233,10 @@ TEST(Scene, AFieldOfViewOf180DegreesIsRefused) {
   transforms["camera_angle_x"] = 3.1415;  // radians: a focal length of 0.0002 pixels
   write_file_atomically(json_path, transforms.dump());
   const std::string message = error_message([&] { load_scene(dir / "scene"); });
-  EXPECT_TRUE(contains(message, "a field of view under 179 degrees")) << message;
+  EXPECT_TRUE(contains(message,
+                       "make a field of view of 180 degrees: a pinhole camera sees less "
+                       "than 179"))
+      << message;
   EXPECT_TRUE(contains(message, "r_0.png")) << message;
 }
 
@@ -251,7 +254,7 @@ TEST(Scene, APrincipalPointFarOutsideTheImageIsRefused) {
   write_file_atomically(dir / "transforms.json", capture.dump());
   const std::string message = error_message([&] { load_scene(dir / "transforms.json"); });
   EXPECT_TRUE(contains(message, "principal point 1e+06, 4 for a 8x8 image")) << message;
-  EXPECT_TRUE(contains(message, "its principal point within an image's size of the image"))
+  EXPECT_TRUE(contains(message, "the principal point lies more than the image's own size outside"))
       << message;
   capture["cx"] = -7.5;  // off-centre, but a lens could be so
   write_file_atomically(dir / "transforms.json", capture.dump());
