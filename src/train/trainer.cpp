@@ -374,8 +374,8 @@ void Trainer::fail_diverged(int64_t iteration, double loss) const {
           : std::string("no checkpoint was written yet");
   fail(
       "training diverged at iteration {}: the {} stopped being finite (loss {}); {}. Lower the "
-      "learning rates, or check the input images and the starting model (--init-ply, "
-      "random_extent).",
+      "learning rates (or a run's depth loss weights, --li and --le), or check the input "
+      "images and the starting model (--init-ply, random_extent).",
       iteration, std::isfinite(loss) ? "parameters" : "loss", loss, kept);
 }
 
