@@ -444,6 +444,15 @@ Scene parse_nerfstudio_transforms(const std::string& text, const fs::path& json_
   std::stable_sort(cameras.begin(), cameras.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   name_below_common_folder(cameras);
+  // nerfstudio trains only where a frame's mask is white; here every pixel is trained on.
+  for (const json& frame : document.at("frames"))
+    if (frame.is_object() && frame.contains("mask_path")) {
+      warn_once(
+          fmt::format("{}: frames' mask_path is not read: every pixel of their images is "
+                      "trained on and scored",
+                      json_path.string()));
+      break;
+    }
   Scene scene;
   scene.format = "nerfstudio";
   scene.synthetic = false;

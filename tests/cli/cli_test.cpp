@@ -100,6 +100,10 @@ TEST(Cli, MissingSceneIsOneLineNamingThePath) {
   EXPECT_EQ(run.status, 1);
   EXPECT_EQ(last_line(run.output),
             "error: " + (dir / "nowhere").string() + ": scene directory not found");
+  write_text(dir / "a.png", "x");  // a file, not a scene
+  EXPECT_EQ(last_line(iesrgs("info " + (dir / "a.png").string()).output),
+            "error: " + (dir / "a.png").string() +
+                ": not a scene: give a scene's folder, or its transforms .json file");
 }
 
 // An empty -o would write into the working folder.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "support/captured_log.hpp"
 #include "support/expect_error.hpp"
 #include "support/projection.hpp"
 #include "support/temp_dir.hpp"
@@ -193,6 +194,26 @@ TEST(NerfstudioScene, SortsFramesByFilePathAndHoldsOutEveryKth) {
   EXPECT_EQ(names, "abcde");
   EXPECT_EQ(splits, "T--T-");
   EXPECT_EQ(scene.cameras[0].image_path, fs::path("/data/images/a.jpg"));
+}
+
+// nerfstudio trains only where a frame's mask is white: a scene with masks is told they are not.
+TEST(NerfstudioScene, MasksAreSaidToBeUnread) {
+  TempDir dir;
+  json document = nerfstudio_document();
+  document["frames"][1]["mask_path"] = "masks/a.png";
+  const fs::path json_path = write_nerfstudio_scene(dir, document);
+  const testing::CapturedLog log;
+  parse_nerfstudio_transforms(
+      document.dump(), json_path, {},
+      [](const fs::path&) {
+        return ImageHeader{8, 6};
+      },
+      [](const fs::path&) { return PointCloud{}; });
+  EXPECT_EQ(log.count(json_path.string() +
+                      ": frames' mask_path is not read: every pixel of their images is trained "
+                      "on and scored"),
+            1u)
+      << log.text();
 }
 
 // The camera names and splits of a scene, in order: "a-" for a training view a, "bT" for a test
