@@ -31,6 +31,7 @@ struct EvalArgs {
   std::string ground_truth;
   std::string output;
   std::string split = "test";
+  std::optional<int> test_every;
   int downscale = 1;
   std::string background = "auto";
   std::string lpips = "alex";
@@ -66,18 +67,24 @@ std::optional<std::array<float, 3>> recorded_background(const nlohmann::json& re
   return background;
 }
 
+// What a render.json says of the views and their background, where it says it.
+struct RenderRecord {
+  std::optional<std::array<float, 3>> background;
+  std::optional<int> test_every;  // of the scene the views were chosen from
+};
+
 // Refuses a render that `iesrgs render` did not finish, and one of other cameras than the ground
 // truth's split, as its render.json records them: names alone do not tell (NeRF Synthetic's
 // splits both start at r_0). Returns the background the renders were drawn over, as recorded.
-std::optional<std::array<float, 3>> check_render_record(const EvalArgs& args) {
+RenderRecord check_render_record(const EvalArgs& args) {
   std::filesystem::path folder = args.renders;
   if (!folder.has_filename()) folder = folder.parent_path();  // given as "out/rgb/"
   if (folder.filename() == "rgb" && !std::filesystem::exists(folder / "render.json"))
     folder = folder.parent_path();
   const std::filesystem::path record = folder / "render.json";
-  if (!std::filesystem::exists(record)) return std::nullopt;
+  if (!std::filesystem::exists(record)) return {};
   const nlohmann::json report = nlohmann::json::parse(read_file(record), nullptr, false);
-  if (!report.is_object()) return std::nullopt;
+  if (!report.is_object()) return {};
   if (const auto finished = report.find("finished"); finished != report.end() && *finished == false)
     fail_file(record, "this render did not finish: render again before scoring it");
   if (is_scene(args.ground_truth)) {
@@ -92,7 +99,11 @@ std::optional<std::array<float, 3>> check_render_record(const EvalArgs& args) {
                                     "them against other views of the same names; use --split {}",
                                     split, args.split, split));
   }
-  return recorded_background(report);
+  const auto test_every = report.find("test_every");
+  return {recorded_background(report),
+          test_every != report.end() && test_every->is_number_integer() && *test_every >= 1
+              ? std::optional<int>(test_every->get<int>())
+              : std::nullopt};
 }
 
 // Ground truth for a render stem: a scene's camera of that name (at --downscale, composited over
@@ -178,13 +189,15 @@ std::filesystem::path report_base(const EvalArgs& args) {
 }
 
 void run_eval(const EvalArgs& args) {
-  const std::optional<std::array<float, 3>> rendered_over = check_render_record(args);
+  const RenderRecord rendered = check_render_record(args);
   SceneArgs scene_args;
   scene_args.options.downscale = args.downscale;
+  scene_args.options.test_every =
+      args.test_every.value_or(rendered.test_every.value_or(scene_args.options.test_every));
   scene_args.background = args.background;
   SceneOptions options = scene_args.resolved();
   // The ground truth over the background the renders were drawn over, as 3DGS scores its renders.
-  if (!options.background) options.background = rendered_over;
+  if (!options.background) options.background = rendered.background;
   const std::filesystem::path base = report_base(args);
   // Before the scoring, which LPIPS makes long. The two files share their folder.
   require_writable(base.string() + ".json");
@@ -246,6 +259,11 @@ void add_eval_command(CLI::App& app) {
   command->add_option("--split", args->split, "Scene split to compare with")
       ->check(CLI::IsMember({"train", "test"}))
       ->capture_default_str();
+  command
+      ->add_option("--test-every", args->test_every,
+                   "Hold out every k-th image for test when the format has no test split "
+                   "(default: the renders' own, which iesrgs render records, else 8)")
+      ->check(kPositive);
   command->add_option("--downscale", args->downscale, "Ground-truth scene resolution 1/k")
       ->check(kPositive)
       ->capture_default_str();

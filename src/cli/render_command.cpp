@@ -88,8 +88,10 @@ void run_render(const RenderArgs& args) {
   fmt::print("rendering {} {} views of {} Gaussians at x{} ({}, background {})\n", cameras.size(),
              what, model.size(), args.scale, mode, fmt::join(scene.background, ","));
   // What eval checks its ground truth against.
-  const nlohmann::json record = args.path.empty() ? nlohmann::json{{"split", args.split}}
-                                                  : nlohmann::json{{"path", args.path}};
+  const nlohmann::json record =
+      args.path.empty()
+          ? nlohmann::json{{"split", args.split}, {"test_every", scene_options.test_every}}
+          : nlohmann::json{{"path", args.path}};
   const double seconds = pipeline::render_views_recorded(args.output, model, cameras,
                                                          scene.background, args.scale, record);
   fmt::print("{:.1f} ms per view ({:.1f} FPS); wrote {}\n", seconds * 1e3,

@@ -154,6 +154,16 @@ TEST(TrainCli, TrainRenderEvalWriteStandardOutputs) {
       << other_split.output;
   EXPECT_EQ(iesrgs("eval --lpips none " + train_views + "/rgb/ " + scene).status, 1);
   EXPECT_EQ(iesrgs("eval --lpips none --split train " + train_views + "/rgb " + scene).status, 0);
+  // A capture's test views are every --test-every-th: eval takes the renders' own, recorded.
+  std::filesystem::copy(dir / "scene", dir / "capture", std::filesystem::copy_options::recursive);
+  for (const char* split : {"transforms_train.json", "transforms_test.json"})
+    std::filesystem::remove(dir / "capture" / split);
+  write_file_atomically(dir / "capture" / "transforms.json",
+                        read_file(dir / "scene" / "transforms_train.json"));
+  const std::string capture = (dir / "capture").string(), held = (dir / "held").string();
+  ASSERT_EQ(iesrgs("render " + out + " " + capture + " -o " + held + " --test-every 2").status, 0);
+  EXPECT_EQ(iesrgs("eval --lpips none " + held + " " + capture).status, 0);
+  EXPECT_EQ(iesrgs("eval --lpips none --test-every 8 " + held + " " + capture).status, 1);
 
   const CliRun bench = iesrgs("bench raster --model " + out + " --scene " + scene +
                               " --scale 2 --views 3 --iterations 1");
