@@ -149,22 +149,51 @@ class Pipeline {
   std::optional<eval::LoadedLpips> lpips_;
 };
 
+// The first view (of the training views, or of all) whose LR size times the scale is not its HR
+// truth's: an LR size rounded, as a scale that does not divide the image size leaves it.
+std::optional<size_t> first_rounded_view(const Scene& hr, const Scene& lr, int scale,
+                                         bool training_only) {
+  for (size_t i = 0; i < hr.cameras.size(); ++i) {
+    if (training_only && hr.cameras[i].split != Split::Train) continue;
+    const Intrinsics &high = hr.cameras[i].intrinsics, &low = lr.cameras[i].intrinsics;
+    if (high.width != low.width * scale || high.height != low.height * scale) return i;
+  }
+  return std::nullopt;
+}
+
+// "at --downscale 1 this view is 64x64, which --scale 3 does not divide", for the i-th view.
+std::string rounded_view_sizes(const Scene& hr, size_t i, int scale) {
+  const Intrinsics& high = hr.cameras[i].intrinsics;
+  return fmt::format("at --downscale {} this view is {}x{}, which --scale {} does not divide",
+                     hr.downscale, high.width, high.height, scale);
+}
+
 // The mask-oracle row compares the references with the HR truth pixel by pixel, at the LR views'
 // size times the scale: the truth must have that size. (Other rows render the test views at the
 // truth's own size, whatever the scale.)
 void require_scale_divides(const Scene& hr, const Scene& lr, int scale) {
-  for (size_t i = 0; i < hr.cameras.size(); ++i) {
-    if (hr.cameras[i].split != Split::Train) continue;
-    const Intrinsics &high = hr.cameras[i].intrinsics, &low = lr.cameras[i].intrinsics;
-    if (high.width == low.width * scale && high.height == low.height * scale) continue;
-    fail_file(hr.cameras[i].image_path,
-              fmt::format("at --downscale {} this view is {}x{}, which --scale {} does not divide "
-                          "(the LR view would be {}x{}, upscaled {}x{}), which the mask-oracle "
-                          "row compares with it pixel by pixel; pick a scale or downscale that "
-                          "divides the image size",
-                          hr.downscale, high.width, high.height, scale, low.width, low.height,
-                          low.width * scale, low.height * scale));
-  }
+  const std::optional<size_t> i = first_rounded_view(hr, lr, scale, true);
+  if (!i) return;
+  const Intrinsics& low = lr.cameras[*i].intrinsics;
+  fail_file(hr.cameras[*i].image_path,
+            fmt::format("{} (the LR view would be {}x{}, upscaled {}x{}), which the mask-oracle "
+                        "row compares with it pixel by pixel; pick a scale or downscale that "
+                        "divides the image size",
+                        rounded_view_sizes(hr, *i, scale), low.width, low.height, low.width * scale,
+                        low.height * scale));
+}
+
+// The HR rows train at the LR size times the scale, and their test views are scored at the
+// truth's own size: said, for the first view where the two differ.
+void warn_if_scale_rounds(const Scene& hr, const Scene& lr, int scale) {
+  const std::optional<size_t> i = first_rounded_view(hr, lr, scale, false);
+  if (!i) return;
+  const Intrinsics &high = hr.cameras[*i].intrinsics, &low = lr.cameras[*i].intrinsics;
+  spdlog::warn(
+      "{}: {}: its LR view is {}x{} (rounded), so the HR models train at {}x{} and are scored at "
+      "{}x{}; a scale or downscale that divides the image size keeps them equal",
+      hr.cameras[*i].image_path.string(), rounded_view_sizes(hr, *i, scale), low.width, low.height,
+      low.width * scale, low.height * scale, high.width, high.height);
 }
 
 Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(options.rows)) {
@@ -187,6 +216,7 @@ Pipeline::Pipeline(const RunOptions& options) : o_(options), rows_(expand_rows(o
         lr_scene_.root.string());
   if (hr_scene_ && any_row([](const RowSpec& row) { return row.oracle_mask; }))
     require_scale_divides(*hr_scene_, lr_scene_, o_.scale);
+  if (hr_scene_) warn_if_scale_rounds(*hr_scene_, lr_scene_, o_.scale);
   require_trainable_views(lr_scene_);
   lr_images_ = std::make_unique<ViewImages>(lr_scene_);
   threshold_ = o_.threshold >= 0     ? o_.threshold

@@ -212,6 +212,15 @@ TEST_F(RunCli, FuseAloneNeedsTheEarlierStagesAndRowsAreChecked) {
   EXPECT_TRUE(contains(last_line(thirds.output), "32x32, which --scale 3 does not divide"))
       << thirds.output;
   EXPECT_FALSE(std::filesystem::exists(out));
+  // The other rows take such a scale, and say what it does to the sizes.
+  const CliRun rounded =
+      iesrgs("run " + scene + " -o " + out + " --scale 3 --rows bicubic" + kTinySchedule);
+  EXPECT_EQ(rounded.status, 0) << rounded.output;
+  EXPECT_TRUE(contains(rounded.output,
+                       "32x32, which --scale 3 does not divide: its LR view is 11x11 (rounded), so "
+                       "the HR models train at 33x33 and are scored at 32x32"))
+      << rounded.output;
+  std::filesystem::remove_all(out);
 
   const CliRun dssim = iesrgs("run " + scene + " -o " + out + " --dssim nan");
   EXPECT_NE(dssim.status, 0);
