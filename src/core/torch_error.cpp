@@ -30,6 +30,18 @@ std::string torch_error_line(const c10::Error& error) {
   return message.substr(0, message.find('\n'));
 }
 
+bool handling_out_of_memory() {
+  try {
+    throw;
+  } catch (const std::bad_alloc&) {
+    return true;
+  } catch (const c10::Error& e) {
+    return !allocation_failure(torch_error_line(e)).empty();
+  } catch (...) {
+    return false;
+  }
+}
+
 std::string current_exception_message() {
   try {
     throw;

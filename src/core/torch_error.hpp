@@ -14,4 +14,8 @@ std::string torch_error_line(const c10::Error& error);
 // for a std::filesystem error; the message of any other exception.
 std::string current_exception_message();
 
+// Whether the exception being handled (call it inside a catch block) is an allocation that
+// failed: std::bad_alloc, or LibTorch's allocator's error.
+bool handling_out_of_memory();
+
 }  // namespace iesrgs

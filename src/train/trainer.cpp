@@ -366,12 +366,22 @@ int64_t Trainer::densify_cap() const {
   return std::min(configured, model_.size() + growth);
 }
 
+std::string Trainer::checkpoint_kept() const {
+  return checkpoint_iteration_ >= 0
+             ? fmt::format("the last good checkpoint (iteration {}) is kept in {}",
+                           checkpoint_iteration_, checkpoint_path().string())
+             : std::string("no checkpoint was written yet");
+}
+
+void Trainer::fail_out_of_memory() const {
+  fail(
+      "{} after iteration {}, training {} Gaussians; {}. The config's max_gaussians caps the "
+      "model's growth.",
+      current_exception_message(), iteration_, model_.size(), checkpoint_kept());
+}
+
 void Trainer::fail_diverged(int64_t iteration, double loss) const {
-  const std::string kept =
-      checkpoint_iteration_ >= 0
-          ? fmt::format("the last good checkpoint (iteration {}) is kept in {}",
-                        checkpoint_iteration_, checkpoint_path().string())
-          : std::string("no checkpoint was written yet");
+  const std::string kept = checkpoint_kept();
   fail(
       "training diverged at iteration {}: the {} stopped being finite (loss {}); {}. Lower the "
       "learning rates (or a run's depth loss weights, --li and --le), or check the input "
@@ -395,13 +405,7 @@ double Trainer::evaluate_psnr(const std::vector<TrainView>& views) const {
   return views.empty() ? 0 : sum / double(views.size());
 }
 
-TrainSummary Trainer::run() {
-  const InterruptScope interrupt_scope;
-  TrainSummary summary;
-  ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations,
-                  config_.log_every, seconds_before_);
-  write_cameras_json(cameras_path(), train_cameras_);
-  run_watch_.restart();
+bool Trainer::train_until_done_or_stopped(ProgressLog& log) {
   while (iteration_ < config_.iterations) {
     last_loss_ = step(iteration_ + 1);
     ++iteration_;
@@ -428,9 +432,24 @@ TrainSummary Trainer::run() {
     if (interrupted && !last) {  // on the last iteration, the run has finished: let it end
       fmt::print("interrupted: checkpoint of iteration {} saved to {}\n", iteration_,
                  checkpoint_path().string());
-      summary.interrupted = true;
-      break;
+      return false;
     }
+  }
+  return true;
+}
+
+TrainSummary Trainer::run() {
+  const InterruptScope interrupt_scope;
+  TrainSummary summary;
+  ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations,
+                  config_.log_every, seconds_before_);
+  write_cameras_json(cameras_path(), train_cameras_);
+  run_watch_.restart();
+  try {
+    summary.interrupted = !train_until_done_or_stopped(log);
+  } catch (...) {
+    if (handling_out_of_memory()) fail_out_of_memory();
+    throw;
   }
   // The finished run's moments are in its checkpoint: freed for the model files written next,
   // which copy the model (near the end of the memory, this is the peak).

@@ -72,6 +72,8 @@ inline std::filesystem::path model_path(const std::filesystem::path& output_dir)
   return output_dir / "point_cloud.ply";
 }
 
+class ProgressLog;
+
 class Trainer {
  public:
   Trainer(const TrainConfig& config, TrainerSetup setup, gs::GaussianModel initial);
@@ -115,6 +117,14 @@ class Trainer {
   void warn_memory_cap(int64_t iteration, int64_t cap, int64_t held_back);
   void save_checkpoint();
   [[noreturn]] void fail_diverged(int64_t iteration, double loss) const;
+  // Out of memory (call it inside a catch block): the error says when, what is kept and what caps
+  // the model's growth.
+  [[noreturn]] void fail_out_of_memory() const;
+  // run's loop: each step, its reports, densification and checkpoints. False when it stopped for
+  // an interrupt, after its checkpoint.
+  bool train_until_done_or_stopped(ProgressLog& log);
+  // "the last good checkpoint (iteration N) is kept in PATH", or that there is none yet.
+  std::string checkpoint_kept() const;
   double training_seconds() const;
 
   TrainConfig config_;

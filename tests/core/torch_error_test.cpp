@@ -48,6 +48,25 @@ TEST(TorchError, FailedLibTorchAllocationIsOutOfMemoryWithItsSize) {
             "out of memory (LibTorch asked for 12.0 MiB)");
 }
 
+template <typename Throw>
+bool out_of_memory(Throw throw_it) {
+  try {
+    throw_it();
+  } catch (...) {
+    return handling_out_of_memory();
+  }
+  return false;
+}
+
+TEST(TorchError, AllocationFailuresAreToldFromOtherErrors) {
+  EXPECT_TRUE(out_of_memory([] { throw std::bad_alloc(); }));
+  EXPECT_TRUE(out_of_memory([] {
+    throw torch_error("DefaultCPUAllocator: can't allocate memory: you tried to allocate 8 bytes.");
+  }));
+  EXPECT_FALSE(out_of_memory([] { throw torch_error("shape mismatch [2, 3]"); }));
+  EXPECT_FALSE(out_of_memory([] { fail("out of memory, says a message"); }));
+}
+
 // Said as the other errors are: the file, then the problem.
 TEST(TorchError, FilesystemErrorsNameThePathFirst) {
   const std::filesystem::filesystem_error denied(
