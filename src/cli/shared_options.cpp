@@ -22,8 +22,9 @@ void add_lpips_option(CLI::App& command, std::string& backbone) {
   command
       .add_option("--lpips", backbone,
                   "LPIPS backbone: alex, vgg, vgg-3dgs (VGG given [0, 1] images, as 3DGS's and "
-                  "Mip-Splatting's metrics.py) or none (torchvision's checkpoint, looked up in "
-                  "$IESRGS_WEIGHTS_DIR, else in torchvision's download cache)")
+                  "Mip-Splatting's metrics.py) or none. A backbone's torchvision checkpoint is "
+                  "looked up in $IESRGS_WEIGHTS_DIR, else in torchvision's download cache "
+                  "(hub/checkpoints under $TORCH_HOME, $XDG_CACHE_HOME/torch or ~/.cache/torch)")
       ->check(CLI::IsMember({"alex", "vgg", "vgg-3dgs", "none"}))
       ->capture_default_str();
 }
