@@ -141,14 +141,13 @@ Scene read_any_format(const fs::path& root, const SceneOptions& options) {
             "transforms.json)");
 }
 
-// One image file under two cameras, however its paths are spelled: a test image would be trained
-// on, or one image given two poses.
+// One image path under two cameras, however it is spelled: a test image would be trained on, or
+// one image given two poses. Symbolic links are not followed: data stores link identical images
+// of distinct frames to one file.
 void require_distinct_images(const Scene& scene) {
   std::map<fs::path, const Camera*> seen;
   for (const Camera& camera : scene.cameras) {
-    std::error_code ec;
-    fs::path file = fs::weakly_canonical(camera.image_path, ec);
-    if (ec) file = camera.image_path.lexically_normal();
+    const fs::path file = fs::absolute(camera.image_path).lexically_normal();
     const auto [it, added] = seen.emplace(file, &camera);
     if (!added)
       fail_file(scene.root,

@@ -82,6 +82,12 @@ TEST(Scene, AnImagePosedTwiceIsRefused) {
     const std::string message = error_message([&] { load_scene(dir / "scene"); });
     EXPECT_TRUE(contains(message, std::string("is posed twice, as ") + views)) << message;
   }
+  // Data stores link identical images of distinct frames to one file: those are two images.
+  nlohmann::json linked = original;
+  std::filesystem::create_symlink(dir / "scene" / "train" / "r_0.png", dir / "scene" / "copy.png");
+  linked["frames"][1]["file_path"] = "copy.png";
+  write_file_atomically(json_path, linked.dump());
+  EXPECT_EQ(load_scene(dir / "scene").cameras.size(), 4u);
 }
 
 // Read as a nerfstudio file, a split file would give a split of its own views.
