@@ -207,9 +207,12 @@ bool set_pinhole(Camera& camera) {
 }
 
 // What the training cameras look at: the SfM points (a subsample, so that the check stays cheap on
-// millions), else the point their optical axes meet. Empty when neither is known.
+// millions), else the point their optical axes meet where they clearly converge on one, within a
+// few times the cameras' spread (a forward-facing capture's nearly parallel axes meet anywhere,
+// behind the cameras too). Empty when neither is known.
 std::vector<Vec3> looked_at_points(const Scene& scene, std::string& what) {
   constexpr size_t kMostPoints = 4096;
+  constexpr double kConvergingSpreads = 3;
   const std::vector<Vec3>& points = scene.points.positions;
   std::vector<Vec3> targets;
   if (!points.empty()) {
@@ -217,25 +220,30 @@ std::vector<Vec3> looked_at_points(const Scene& scene, std::string& what) {
     const size_t step = (points.size() + kMostPoints - 1) / kMostPoints;
     for (size_t i = 0; i < points.size(); i += step) targets.push_back(points[i]);
   } else if (const std::optional<Vec3> focus = focus_point(scene.split(Split::Train))) {
-    what = "the point their optical axes meet";
-    targets.push_back(*focus);
+    const SceneNormalization sphere = scene.normalization();
+    if ((*focus - sphere.center).norm() <= kConvergingSpreads * sphere.radius / 1.1) {
+      what = "the point their optical axes meet";
+      targets.push_back(*focus);
+    }
   }
   return targets;
 }
 
-// Most training cameras with what they look at behind them: a pose convention mistaken (a
-// transforms.json written with OpenCV's axes), whose views would show nothing to learn from.
+// Most training cameras with (nearly) all they look at behind them: a pose convention mistaken (a
+// transforms.json written with OpenCV's axes), whose views would show nothing to learn from. A
+// camera inside the scene sees about half its points: it faces none away.
 std::optional<std::string> camera_facing_warning(const Scene& scene) {
+  constexpr double kFewestInFront = 0.1;
   std::string what;
   const std::vector<Vec3> targets = looked_at_points(scene, what);
   const std::vector<const Camera*> cameras = scene.split(Split::Train);
   if (targets.empty()) return std::nullopt;
   size_t away = 0;
   for (const Camera* camera : cameras) {
-    std::vector<double> depths;
+    size_t in_front = 0;
     for (const Vec3& target : targets)
-      depths.push_back((camera->rotation * target + camera->translation).z);
-    away += median(depths) <= 0;
+      in_front += (camera->rotation * target + camera->translation).z > 0;
+    away += double(in_front) < kFewestInFront * double(targets.size());
   }
   if (2 * away <= cameras.size()) return std::nullopt;
   return fmt::format(

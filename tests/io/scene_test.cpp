@@ -231,6 +231,36 @@ TEST(Scene, CamerasFacingAwayAreWarnedAbout) {
   EXPECT_TRUE(contains(turned[0], "one written with OpenCV's, z forward")) << turned[0];
 }
 
+// A forward-facing capture's nearly parallel axes may meet behind it, and a camera inside the
+// scene sees half its points: neither faces away.
+TEST(Scene, ForwardFacingAndInsideOutCapturesAreNotWarnedAbout) {
+  for (const double tilt : {-0.035, 0.035}) {  // 2 degrees, outward or inward
+    Scene forward;
+    for (double x = -2; x <= 2; ++x)
+      for (double y = -1; y <= 1; ++y) {
+        Camera camera;
+        camera.rotation = quat_to_rotation(std::cos(tilt * x / 2), 0, std::sin(tilt * x / 2), 0);
+        camera.translation = -(camera.rotation * Vec3{x, y, 0});
+        forward.cameras.push_back(camera);
+      }
+    const std::vector<std::string> warnings = camera_warnings(forward);
+    EXPECT_TRUE(warnings.empty()) << tilt << ": " << warnings.front();
+  }
+  Scene inside_out;
+  for (int k = 0; k < 8; ++k) {
+    const double turn = k * kPi / 4;  // about y: looking out along the ring
+    Camera camera;
+    camera.rotation = quat_to_rotation(std::cos(turn / 2), 0, std::sin(turn / 2), 0);
+    camera.translation = -(camera.rotation * Vec3{std::sin(turn), 0, std::cos(turn)});
+    inside_out.cameras.push_back(camera);
+    for (int j = 0; j < 16; ++j)
+      inside_out.points.positions.push_back(
+          {10 * std::cos(j * kPi / 8), 0.5 * (j % 3), 10 * std::sin(j * kPi / 8)});
+  }
+  const std::vector<std::string> warnings = camera_warnings(inside_out);
+  EXPECT_TRUE(warnings.empty()) << warnings.front();
+}
+
 TEST(Scene, AFieldOfViewOf180DegreesIsRefused) {
   TempDir dir;
   synth::write_synth_dataset(dir / "scene", {synth::SynthFormat::Blender, 8, 2, 1});
