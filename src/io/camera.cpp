@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/error.hpp"
-
 namespace iesrgs {
 
 const char* split_name(Split split) {
@@ -49,15 +47,6 @@ Camera Camera::scaled(double scale) const {
   Camera c = *this;
   c.intrinsics = intrinsics.scaled(scale);
   return c;
-}
-
-void require_images_exist(const std::vector<Camera>& cameras,
-                          const std::filesystem::path& index_file) {
-  for (const Camera& camera : cameras) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(camera.image_path, ec))
-      fail_file(index_file, fmt::format("image {} not found", camera.image_path.string()));
-  }
 }
 
 std::optional<Vec3> focus_point(const std::vector<const Camera*>& cameras) {

@@ -92,11 +92,6 @@ struct Camera {
 // None for fewer than two cameras, and when the axes are parallel (a rig of parallel cameras).
 std::optional<Vec3> focus_point(const std::vector<const Camera*>& cameras);
 
-// Fails naming `index_file` (the file that lists the images) at the first camera whose image is
-// not a file: checked as the scene loads, not when a stage reaches that view.
-void require_images_exist(const std::vector<Camera>& cameras,
-                          const std::filesystem::path& index_file);
-
 // World-to-camera (OpenCV) from a camera-to-world matrix in the OpenGL / NeRF convention
 // (x right, y up, z backward), as stored by NeRF-Synthetic and nerfstudio transforms.json.
 void opengl_c2w_to_opencv_w2c(const double c2w[4][4], Mat3& rotation, Vec3& translation);

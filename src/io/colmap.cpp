@@ -247,6 +247,21 @@ fs::path model_dir(const fs::path& root) {
   return fs::is_directory(first, ec) ? first : root / "sparse";
 }
 
+// Each image, or at --downscale k its copy in images_<k>/, which is all such a run reads: a capture
+// may keep only the copies. Looked for as the scene loads, not when a stage reaches the view.
+void require_images_or_copies(const std::vector<Camera>& cameras, const fs::path& root,
+                              int downscale, const fs::path& images_file) {
+  const fs::path copies = root / fmt::format("images_{}", downscale);
+  for (const Camera& camera : cameras) {
+    std::error_code ec;
+    const fs::path copy = copies / camera.image_path.lexically_relative(root / "images");
+    if (fs::is_regular_file(camera.image_path, ec) ||
+        (downscale > 1 && fs::is_regular_file(copy, ec)))
+      continue;
+    fail_file(images_file, fmt::format("image {} not found", camera.image_path.string()));
+  }
+}
+
 }  // namespace
 
 Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
@@ -299,7 +314,7 @@ Scene read_colmap_scene(const fs::path& root, const SceneOptions& options) {
     camera.split = i % options.test_every == 0 ? Split::Test : Split::Train;
     scene.cameras.push_back(std::move(camera));
   }
-  require_images_exist(scene.cameras, files.images);
+  require_images_or_copies(scene.cameras, root, options.downscale, files.images);
   scene.points = sfm_points(model, files);
   return scene;
 }

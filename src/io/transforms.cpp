@@ -160,6 +160,14 @@ Intrinsics centered_intrinsics(int width, int height, double fx, double fy) {
   return {width, height, fx, fy, width / 2.0, height / 2.0};
 }
 
+void require_images_exist(const std::vector<Camera>& cameras, const fs::path& json_path) {
+  for (const Camera& camera : cameras) {
+    std::error_code ec;
+    if (!fs::is_regular_file(camera.image_path, ec))
+      fail_file(json_path, fmt::format("image {} not found", camera.image_path.string()));
+  }
+}
+
 // The image a frame names: the file as written when it exists, else with Windows separators
 // made '/', else with the first of `extensions` that gives a file appended. Blender frames leave
 // ".png" out (3DGS always appends it, even to "r_0.001"); instant-ngp tries common image

@@ -362,6 +362,13 @@ TEST(Colmap, AnImageTheModelListsButImagesLacksIsNamedAtLoad) {
   fs::remove(root / "images" / "frame_e.jpg");
   expect_error([&] { load_scene(root.path()); },
                {(root / "sparse/0/images.bin").string(), "frame_e.jpg not found"});
+  // A run at --downscale 2 reads images_2/ alone: a capture may keep only that.
+  fs::rename(root / "images", root / "images_2");
+  write_text(root / "images_2" / "frame_e.jpg", "");
+  SceneOptions half;
+  half.downscale = 2;
+  EXPECT_EQ(load_scene(root.path(), half).cameras.size(), 6u);
+  expect_error([&] { load_scene(root.path()); }, {"frame_a.jpg not found"});
 }
 
 TEST(Colmap, LoadSceneDispatchesToColmap) {
