@@ -110,7 +110,8 @@ RenderRecord check_render_record(const EvalArgs& args) {
 // the background), or an image of that stem in a plain folder.
 class GroundTruth {
  public:
-  GroundTruth(const EvalArgs& args, const SceneOptions& options) : root_(args.ground_truth) {
+  GroundTruth(const EvalArgs& args, const SceneOptions& options)
+      : root_(args.ground_truth), test_every_(options.test_every) {
     if (!is_scene(root_) && !std::filesystem::is_directory(root_))
       fail_file(root_, "ground truth not found: neither a scene nor a folder of images");
     if (is_scene(root_)) {
@@ -147,7 +148,12 @@ class GroundTruth {
     if (scene_) {
       const auto found = cameras_.find(name);
       if (found == cameras_.end())
-        fail_file(root_, fmt::format("has no view named \"{}\" in the chosen split", name));
+        fail_file(root_, fmt::format("has no view named \"{}\" in the chosen split{}", name,
+                                     scene_->format == "blender"
+                                         ? ""
+                                         : fmt::format(" (every {}th image held out: renders of "
+                                                       "another --test-every?)",
+                                                       test_every_)));
       return *images_->rgb(*found->second);
     }
     for (const char* ext : kImageExtensionSpellings) {
@@ -161,6 +167,7 @@ class GroundTruth {
  private:
   std::filesystem::path root_;
   std::array<float, 3> background_{};
+  int test_every_;
   std::optional<Scene> scene_;
   std::optional<ViewImages> images_;
   std::map<std::string, const Camera*> cameras_;

@@ -6,11 +6,12 @@
 namespace iesrgs::pipeline {
 
 Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector<Camera>& cameras,
-                               const std::array<float, 3>& background, ViewImages* truth,
-                               const eval::LoadedLpips& lpips, const std::filesystem::path& dir) {
+                               int test_every, const std::array<float, 3>& background,
+                               ViewImages* truth, const eval::LoadedLpips& lpips,
+                               const std::filesystem::path& dir) {
   Evaluation evaluation;
-  evaluation.seconds_per_view =
-      render_views_recorded(dir, model, cameras, background, 1.0, {{"split", "test"}});
+  evaluation.seconds_per_view = render_views_recorded(
+      dir, model, cameras, background, 1.0, {{"split", "test"}, {"test_every", test_every}});
   if (!truth) return evaluation;
   eval::MetricsReport& report = evaluation.report;
   for (const Camera& camera : cameras) {

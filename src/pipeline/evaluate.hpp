@@ -18,12 +18,13 @@ struct Evaluation {
   double seconds_per_view = 0;  // rendering alone
 };
 
-// Renders the test views `cameras` into <dir>/{rgb,depth,alpha}, recorded in <dir>/render.json
-// (render_views_recorded) for eval; with `truth`, scores every render against
-// truth->rgb(camera), with LPIPS when `lpips` holds the metric, and writes <dir>/metrics.json
-// and .csv.
+// Renders the test views `cameras` (held out as every `test_every`-th where the scene has no
+// split) into <dir>/{rgb,depth,alpha}, recorded in <dir>/render.json (render_views_recorded) for
+// eval; with `truth`, scores every render against truth->rgb(camera), with LPIPS when `lpips`
+// holds the metric, and writes <dir>/metrics.json and .csv.
 Evaluation render_and_evaluate(const gs::GaussianModel& model, const std::vector<Camera>& cameras,
-                               const std::array<float, 3>& background, ViewImages* truth,
-                               const eval::LoadedLpips& lpips, const std::filesystem::path& dir);
+                               int test_every, const std::array<float, 3>& background,
+                               ViewImages* truth, const eval::LoadedLpips& lpips,
+                               const std::filesystem::path& dir);
 
 }  // namespace iesrgs::pipeline

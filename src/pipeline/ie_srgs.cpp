@@ -462,8 +462,8 @@ RowResult Pipeline::evaluate_row(const RowSpec& row, const gs::GaussianModel& mo
   if (hr_images_ && !lpips_) lpips_ = eval::load_default_lpips(o_.lpips);
   const Stopwatch watch;
   const Evaluation evaluation =
-      render_and_evaluate(model, test_cameras(), lr_scene_.background, hr_images_.get(),
-                          lpips_ ? *lpips_ : eval::LoadedLpips{}, dir / "test");
+      render_and_evaluate(model, test_cameras(), o_.scene_options.test_every, lr_scene_.background,
+                          hr_images_.get(), lpips_ ? *lpips_ : eval::LoadedLpips{}, dir / "test");
   stages_["evaluation_seconds"][row.id] = watch.seconds();
   RowResult result;
   result.id = row.id;

@@ -1,9 +1,11 @@
 #include "pipeline/evaluate.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 
+#include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "pipeline/render_views.hpp"
 #include "support/one_gaussian.hpp"
@@ -36,8 +38,12 @@ TEST(Evaluate, WithoutGroundTruthOnlyRenders) {
   const testing::TempDir dir;
   const testing::OneGaussian one;
   const Evaluation evaluation =
-      render_and_evaluate(one.model, {one.camera}, {1, 1, 1}, nullptr, no_lpips(), dir / "test");
+      render_and_evaluate(one.model, {one.camera}, 8, {1, 1, 1}, nullptr, no_lpips(), dir / "test");
   EXPECT_TRUE(fs::exists(rendered_view_files(dir / "test", "v").rgb));
+  // What eval needs to find the views: the split, and how it was held out.
+  const auto record = nlohmann::json::parse(read_file(dir / "test" / "render.json"));
+  EXPECT_EQ(record["split"], "test");
+  EXPECT_EQ(record["test_every"], 8);
   EXPECT_TRUE(evaluation.report.views.empty());
   EXPECT_FALSE(fs::exists(dir / "test" / "metrics.json"));
   EXPECT_GT(evaluation.seconds_per_view, 0);
@@ -46,13 +52,13 @@ TEST(Evaluate, WithoutGroundTruthOnlyRenders) {
 TEST(Evaluate, ScoresTheRendersAsWrittenAgainstTheTruth) {
   const testing::TempDir dir;
   const testing::OneGaussian one;
-  render_and_evaluate(one.model, {one.camera}, {1, 1, 1}, nullptr, no_lpips(), dir / "first");
+  render_and_evaluate(one.model, {one.camera}, 8, {1, 1, 1}, nullptr, no_lpips(), dir / "first");
   // The 8-bit render itself as the truth: what is scored is the file, so the scores are exact.
   const Image8 written = read_image8(rendered_view_files(dir / "first", "v").rgb);
   const Scene same_scene = one_view_scene(dir / "same_truth", one.camera, written);
   ViewImages same_truth(same_scene);
-  const Evaluation same = render_and_evaluate(one.model, same_scene.cameras, {1, 1, 1}, &same_truth,
-                                              no_lpips(), dir / "same");
+  const Evaluation same = render_and_evaluate(one.model, same_scene.cameras, 8, {1, 1, 1},
+                                              &same_truth, no_lpips(), dir / "same");
   ASSERT_EQ(same.report.views.size(), 1u);
   EXPECT_EQ(same.report.views[0].name, "v");
   EXPECT_TRUE(std::isinf(same.report.views[0].psnr));
@@ -64,7 +70,7 @@ TEST(Evaluate, ScoresTheRendersAsWrittenAgainstTheTruth) {
 
   const Scene black_scene = one_view_scene(dir / "black_truth", one.camera, Image8(64, 48, 3));
   ViewImages black_truth(black_scene);
-  const Evaluation black = render_and_evaluate(one.model, black_scene.cameras, {1, 1, 1},
+  const Evaluation black = render_and_evaluate(one.model, black_scene.cameras, 8, {1, 1, 1},
                                                &black_truth, no_lpips(), dir / "black");
   ASSERT_EQ(black.report.views.size(), 1u);
   EXPECT_LT(black.report.views[0].psnr, 5);  // a mostly white render against black
