@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <atomic>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -97,14 +98,29 @@ double gib(int64_t bytes) {
   return double(bytes) / double(int64_t(1) << 30);
 }
 
+// The process's peak before the last restart_peak_memory, which VmHWM no longer holds.
+std::atomic<int64_t> peak_before_restart{0};
+
 }  // namespace
 
-int64_t peak_memory_bytes() {
+int64_t recent_peak_memory_bytes() {
   return std::max<int64_t>(0, proc_kib_field("/proc/self/status", "VmHWM:"));
+}
+
+int64_t peak_memory_bytes() {
+  return std::max(peak_before_restart.load(), recent_peak_memory_bytes());
 }
 
 int64_t resident_memory_bytes() {
   return std::max<int64_t>(0, proc_kib_field("/proc/self/status", "VmRSS:"));
+}
+
+void restart_peak_memory() {
+  const int64_t peak = peak_memory_bytes();
+  int64_t earlier = peak_before_restart.load();
+  while (earlier < peak && !peak_before_restart.compare_exchange_weak(earlier, peak)) {
+  }
+  std::ofstream("/proc/self/clear_refs") << "5";  // resets VmHWM to VmRSS
 }
 
 int64_t limited_memory_bytes(const fs::path& cgroup_mount, const fs::path& proc_self) {

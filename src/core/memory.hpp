@@ -13,6 +13,14 @@ int64_t peak_memory_bytes();
 // Resident memory of this process now (VmRSS), in bytes; 0 where the OS does not say.
 int64_t resident_memory_bytes();
 
+// Starts recent_peak_memory_bytes afresh from the present resident memory (Linux's clear_refs),
+// so that it measures one piece of work, not the process's earlier ones.
+void restart_peak_memory();
+
+// Peak resident memory since restart_peak_memory (the process's peak where the OS does not allow
+// a restart, or before any), in bytes; 0 where the OS does not say.
+int64_t recent_peak_memory_bytes();
+
 // What new allocations on `device` can get, in bytes: on the CPU without swapping (MemAvailable,
 // or less where limited_memory_bytes says so), on a GPU its free memory; -1 where neither the OS
 // nor the device says.

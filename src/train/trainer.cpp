@@ -356,10 +356,11 @@ int64_t Trainer::densify_cap() const {
   const int64_t configured =
       config_.max_gaussians > 0 ? config_.max_gaussians : std::numeric_limits<int64_t>::max();
   if (available < 0) return configured;
-  // A training step's buffers are freed between steps: what the process has held above its
+  // A training step's buffers are freed between steps: what this training has held above its
   // present size (on the CPU, where that is measured) is taken again by the next step.
   const int64_t step_buffers =
-      device_.is_cpu() ? std::max<int64_t>(0, peak_memory_bytes() - resident_memory_bytes()) : 0;
+      device_.is_cpu() ? std::max<int64_t>(0, recent_peak_memory_bytes() - resident_memory_bytes())
+                       : 0;
   // Each new Gaussian counted twice: densification's copies of the parameters and moments, and
   // the allocator's slack, come on top of its steady cost.
   const int64_t growth = std::max<int64_t>(0, available - step_buffers) / (2 * kBytesPerGaussian);
@@ -440,6 +441,8 @@ bool Trainer::train_until_done_or_stopped(ProgressLog& log) {
 
 TrainSummary Trainer::run() {
   const InterruptScope interrupt_scope;
+  // The peak densify_cap reads is this training's, not that of a run's earlier rows.
+  restart_peak_memory();
   TrainSummary summary;
   ProgressLog log(setup_.output_dir / "train_log.csv", iteration_, config_.iterations,
                   config_.log_every, seconds_before_);
