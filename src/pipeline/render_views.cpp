@@ -1,6 +1,7 @@
 #include "pipeline/render_views.hpp"
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -161,6 +162,7 @@ double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel
   if (!cameras.empty()) render_view(model, cameras.front().scaled(scale), background);
   double render_seconds = 0;
   size_t clamped = 0;
+  bool any_drawn = false;
   for (size_t i = 0; i < cameras.size(); ++i) {
     stop_if_interrupted("rendering");
     const Camera camera = cameras[i].scaled(scale);
@@ -168,10 +170,17 @@ double render_views_to(const std::filesystem::path& dir, const gs::GaussianModel
     const RenderedView view = render_view(model, camera, background);
     render_seconds += watch.seconds();
     clamped += write_rendered_view(dir, camera.name, view);
+    any_drawn = any_drawn || view.alpha.max().item<float>() >= 0.5f / 255;
     if ((i + 1) % 20 == 0 || i + 1 == cameras.size())
       fmt::print("rendered {}/{} views at {}x{}\n", i + 1, cameras.size(), camera.intrinsics.width,
                  camera.intrinsics.height);
   }
+  // Blank views are written and timed as any others, but are seldom what was meant.
+  if (!any_drawn && !cameras.empty())
+    spdlog::warn(
+        "every view rendered blank, the background alone: the model lies outside these cameras' "
+        "views (another scene's cameras, or poses in another convention?), or none of its "
+        "Gaussians can be drawn (zero rotations, scales that overflow)");
   if (clamped)
     fmt::print(
         "note: {} {} farther than {} scene units, the most a 16-bit depth PNG holds at x{}; "

@@ -8,6 +8,7 @@
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "io/npy.hpp"
+#include "support/captured_log.hpp"
 #include "support/one_gaussian.hpp"
 #include "support/temp_dir.hpp"
 
@@ -63,6 +64,20 @@ TEST(RenderViews, SaysWhenTheDepthPngClamps) {
   ::testing::internal::CaptureStdout();
   render_views_to(dir.path(), OneGaussian().model, {OneGaussian().camera}, {1, 1, 1}, 1.0);
   EXPECT_EQ(::testing::internal::GetCapturedStdout().find("note:"), std::string::npos);
+}
+
+// Views that show nothing but the background are written, and said to be blank.
+TEST(RenderViews, SaysWhenEveryViewIsBlank) {
+  testing::TempDir dir;
+  const OneGaussian scene;
+  Camera away = testing::camera_at({0, -4, 0}, {0, -8, 0});  // the Gaussian behind it
+  away.name = "away";
+  testing::CapturedLog log;
+  render_views_to(dir.path(), scene.model, {away}, {1, 1, 1}, 1.0);
+  EXPECT_EQ(log.count("every view rendered blank"), 1u) << log.text();
+  EXPECT_TRUE(std::filesystem::exists(rendered_view_files(dir.path(), "away").rgb));
+  render_views_to(dir.path(), scene.model, {away, scene.camera}, {1, 1, 1}, 1.0);
+  EXPECT_EQ(log.count("every view rendered blank"), 1u) << log.text();
 }
 
 // A recorded render into a folder replaces the earlier one's: its views this one does not make go
