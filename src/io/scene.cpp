@@ -206,13 +206,27 @@ bool set_pinhole(Camera& camera) {
   return pinhole.has_value();
 }
 
+// The largest angle between a camera's optical axis and the cameras' mean axis, in radians.
+double axis_spread(const std::vector<const Camera*>& cameras) {
+  Vec3 mean;
+  for (const Camera* camera : cameras) mean = mean + camera->axis(2);
+  if (!(mean.norm() > 0)) return kPi;
+  mean = mean * (1.0 / mean.norm());
+  double widest = 0;
+  for (const Camera* camera : cameras)
+    widest = std::max(widest, std::acos(std::clamp(camera->axis(2).dot(mean), -1.0, 1.0)));
+  return widest;
+}
+
 // What the training cameras look at: the SfM points (a subsample, so that the check stays cheap on
-// millions), else the point their optical axes meet where they clearly converge on one, within a
-// few times the cameras' spread (a forward-facing capture's nearly parallel axes meet anywhere,
-// behind the cameras too). Empty when neither is known.
+// millions), else the point their optical axes meet where they clearly converge on one: within a
+// few times the cameras' spread, or with axes more than 10 degrees apart. (A forward-facing
+// capture's nearly parallel axes meet anywhere, behind the cameras too.) Empty when neither is
+// known.
 std::vector<Vec3> looked_at_points(const Scene& scene, std::string& what) {
   constexpr size_t kMostPoints = 4096;
   constexpr double kConvergingSpreads = 3;
+  constexpr double kConvergingAngle = 10 * kPi / 180;
   const std::vector<Vec3>& points = scene.points.positions;
   std::vector<Vec3> targets;
   if (!points.empty()) {
@@ -221,7 +235,8 @@ std::vector<Vec3> looked_at_points(const Scene& scene, std::string& what) {
     for (size_t i = 0; i < points.size(); i += step) targets.push_back(points[i]);
   } else if (const std::optional<Vec3> focus = focus_point(scene.split(Split::Train))) {
     const SceneNormalization sphere = scene.normalization();
-    if ((*focus - sphere.center).norm() <= kConvergingSpreads * sphere.radius / 1.1) {
+    if ((*focus - sphere.center).norm() <= kConvergingSpreads * sphere.radius / 1.1 ||
+        axis_spread(scene.split(Split::Train)) > kConvergingAngle) {
       what = "the point their optical axes meet";
       targets.push_back(*focus);
     }

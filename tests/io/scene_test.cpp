@@ -10,6 +10,7 @@
 #include "io/atomic_file.hpp"
 #include "io/image.hpp"
 #include "support/expect_error.hpp"
+#include "support/looking_cameras.hpp"
 #include "support/temp_dir.hpp"
 #include "synth/dataset_writer.hpp"
 
@@ -229,6 +230,20 @@ TEST(Scene, CamerasFacingAwayAreWarnedAbout) {
                        "optical axes meet: their views would show none of it"))
       << turned[0];
   EXPECT_TRUE(contains(turned[0], "one written with OpenCV's, z forward")) << turned[0];
+
+  // Turned around on a narrow arc (24 degrees of it), with no points: their axes still meet.
+  Scene arc;
+  for (int k = -2; k <= 2; ++k) {
+    const double angle = k * 6 * kPi / 180;
+    const Vec3 eye{4 * std::sin(angle), -4 * std::cos(angle), 0};
+    arc.cameras.push_back(testing::camera_at(eye, eye * 2.0));
+  }
+  const std::vector<std::string> narrow = camera_warnings(arc);
+  ASSERT_EQ(narrow.size(), 1u);
+  EXPECT_TRUE(contains(narrow[0],
+                       "5 of the 5 training cameras face away from the point their "
+                       "optical axes meet"))
+      << narrow[0];
 }
 
 // A forward-facing capture's nearly parallel axes may meet behind it, and a camera inside the
