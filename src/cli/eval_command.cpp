@@ -151,8 +151,9 @@ class GroundTruth {
         fail_file(root_, fmt::format("has no view named \"{}\" in the chosen split{}", name,
                                      scene_->format == "blender"
                                          ? ""
-                                         : fmt::format(" (every {}th image held out: renders of "
-                                                       "another --test-every?)",
+                                         : fmt::format(" (--test-every {} here, where the "
+                                                       "scene lists no split: renders made with "
+                                                       "another?)",
                                                        test_every_)));
       return *images_->rgb(*found->second);
     }

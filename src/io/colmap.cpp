@@ -258,7 +258,10 @@ void require_images_or_copies(const std::vector<Camera>& cameras, const fs::path
     if (fs::is_regular_file(camera.image_path, ec) ||
         (downscale > 1 && fs::is_regular_file(copy, ec)))
       continue;
-    fail_file(images_file, fmt::format("image {} not found", camera.image_path.string()));
+    fail_file(images_file, downscale > 1
+                               ? fmt::format("image {} not found, nor its copy {}",
+                                             camera.image_path.string(), copy.string())
+                               : fmt::format("image {} not found", camera.image_path.string()));
   }
 }
 
