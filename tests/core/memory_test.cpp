@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "support/child_process.hpp"
 #include "support/cuda_device.hpp"
@@ -29,6 +30,22 @@ TEST(Memory, RequiringMoreThanIsAvailableNamesWhatNeedsIt) {
   const int64_t too_much = available_memory_bytes() + (int64_t(1) << 30);
   const std::string message = error_message([&] { require_memory(too_much, "a huge buffer"); });
   EXPECT_TRUE(contains(message, "not enough memory: a huge buffer needs about")) << message;
+}
+
+// One piece of work's peak, apart from the process's: a training's, after an earlier row's.
+TEST(Memory, APeakRestartsForOnePieceOfWorkAndTheProcesssStays) {
+  {
+    std::vector<char> touched(size_t(256) << 20, 1);  // resident while it lives
+    EXPECT_GE(recent_peak_memory_bytes(), resident_memory_bytes());
+    EXPECT_GE(recent_peak_memory_bytes(), int64_t(touched.size()));
+  }
+  const int64_t lifetime = peak_memory_bytes();
+  restart_peak_memory();
+  EXPECT_GE(peak_memory_bytes(), lifetime);
+  EXPECT_LE(recent_peak_memory_bytes(), lifetime);
+#if !defined(__SANITIZE_ADDRESS__)  // whose allocator keeps freed memory in quarantine
+  EXPECT_LT(recent_peak_memory_bytes(), lifetime - (int64_t(128) << 20));
+#endif
 }
 
 // MemAvailable from /proc/meminfo, in bytes, read here independently of the library.
