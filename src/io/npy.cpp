@@ -83,7 +83,8 @@ NpyArray read_npy(const fs::path& path) {
   if (bytes.size() - data_offset != count * sizeof(float))
     fail_file(path, "data size does not match the header's shape");
   array.data.resize(count);
-  std::memcpy(array.data.data(), bytes.data() + data_offset, count * sizeof(float));
+  // An array with a zero dimension has no data, and memcpy may not be given its null pointer.
+  if (count > 0) std::memcpy(array.data.data(), bytes.data() + data_offset, count * sizeof(float));
   return array;
 }
 

@@ -21,6 +21,15 @@ TEST(Npy, RoundTrip) {
   EXPECT_EQ(back.data, values);
 }
 
+// A zero dimension: no data at all (memcpy may not be given the empty array's null pointer).
+TEST(Npy, AnArrayWithNoElementsRoundTrips) {
+  testing::TempDir dir;
+  write_npy(dir / "empty.npy", {}, {0, 3});
+  const NpyArray array = read_npy(dir / "empty.npy");
+  EXPECT_EQ(array.shape, (std::vector<size_t>{0, 3}));
+  EXPECT_TRUE(array.data.empty());
+}
+
 TEST(Npy, HeaderIsNumpyVersionOneAlignedTo64Bytes) {
   TempDir dir;
   write_npy(dir / "v.npy", {1.f, 2.f, 3.f}, {3});
