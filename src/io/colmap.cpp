@@ -251,17 +251,16 @@ fs::path model_dir(const fs::path& root) {
 // may keep only the copies. Looked for as the scene loads, not when a stage reaches the view.
 void require_images_or_copies(const std::vector<Camera>& cameras, const fs::path& root,
                               int downscale, const fs::path& images_file) {
-  const fs::path copies = root / fmt::format("images_{}", downscale);
   for (const Camera& camera : cameras) {
     std::error_code ec;
-    const fs::path copy = copies / camera.image_path.lexically_relative(root / "images");
+    const fs::path copy = downscaled_copy(root, camera.image_path, downscale).file;
     if (fs::is_regular_file(camera.image_path, ec) ||
-        (downscale > 1 && fs::is_regular_file(copy, ec)))
+        (!copy.empty() && fs::is_regular_file(copy, ec)))
       continue;
-    fail_file(images_file, downscale > 1
-                               ? fmt::format("image {} not found, nor its copy {}",
-                                             camera.image_path.string(), copy.string())
-                               : fmt::format("image {} not found", camera.image_path.string()));
+    fail_file(images_file, copy.empty()
+                               ? fmt::format("image {} not found", camera.image_path.string())
+                               : fmt::format("image {} not found, nor its copy {}",
+                                             camera.image_path.string(), copy.string()));
   }
 }
 

@@ -336,6 +336,22 @@ std::vector<std::string> camera_warnings(const Scene& scene) {
   return warnings;
 }
 
+DownscaledCopy downscaled_copy(const fs::path& scene_root, const fs::path& image_path,
+                               int downscale) {
+  if (downscale <= 1) return {};
+  std::error_code ec;
+  const fs::path root = fs::is_regular_file(scene_root, ec) ? scene_root.parent_path() : scene_root;
+  const fs::path relative = image_path.lexically_relative(root);
+  if (relative.empty() || *relative.begin() == ".." ||
+      std::next(relative.begin()) == relative.end())
+    return {};
+  DownscaledCopy copy;
+  copy.folder = root / (relative.begin()->string() + "_" + std::to_string(downscale));
+  copy.file = copy.folder;
+  for (auto part = std::next(relative.begin()); part != relative.end(); ++part) copy.file /= *part;
+  return copy;
+}
+
 fs::path scene_folder(const fs::path& root) {
   return fs::is_directory(root) ? root : root.parent_path();
 }

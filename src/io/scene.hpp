@@ -54,6 +54,17 @@ std::filesystem::path scene_folder(const std::filesystem::path& root);
 // as its own. A folder inside it is fine.
 void refuse_output_in_scene_folder(const std::filesystem::path& output, const Scene& scene);
 
+// Where the pre-downscaled copy of an image would be: the image's top folder below the scene root
+// gets "_<k>" (COLMAP / nerfstudio convention: images/cam0/a.png -> images_2/cam0/a.png). A scene
+// given as its transforms.json has that file's folder as its root. Empty when there is none to
+// look for: no downscale, or an image not inside a folder of the scene.
+struct DownscaledCopy {
+  std::filesystem::path folder;  // images_<k>
+  std::filesystem::path file;
+};
+DownscaledCopy downscaled_copy(const std::filesystem::path& scene_root,
+                               const std::filesystem::path& image_path, int downscale);
+
 // Whether load_scene would recognise a format at `path` (a plain folder of images is not a scene).
 bool is_scene(const std::filesystem::path& path);
 

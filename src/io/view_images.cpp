@@ -21,31 +21,6 @@ std::string describe(const Intrinsics& k) {
   return fmt::format("{}x{}", k.width, k.height);
 }
 
-// Where the pre-downscaled copy of an image would be: the image's top folder below the scene root
-// gets "_<k>" (COLMAP / nerfstudio convention: images/cam0/a.png -> images_2/cam0/a.png). A scene
-// given as its transforms.json has that file's folder as its root. Empty when there is none to
-// look for: no downscale, or an image not inside a folder of the scene.
-struct DownscaledCopy {
-  fs::path folder;  // images_<k>
-  fs::path file;
-};
-
-DownscaledCopy downscaled_copy(const fs::path& scene_root, const fs::path& image_path,
-                               int downscale) {
-  if (downscale <= 1) return {};
-  std::error_code ec;
-  const fs::path root = fs::is_regular_file(scene_root, ec) ? scene_root.parent_path() : scene_root;
-  const fs::path relative = image_path.lexically_relative(root);
-  if (relative.empty() || *relative.begin() == ".." ||
-      std::next(relative.begin()) == relative.end())
-    return {};
-  DownscaledCopy copy;
-  copy.folder = root / (relative.begin()->string() + "_" + std::to_string(downscale));
-  copy.file = copy.folder;
-  for (auto part = std::next(relative.begin()); part != relative.end(); ++part) copy.file /= *part;
-  return copy;
-}
-
 // Identifies an undistorted result: the source's content and every parameter used.
 std::string undistort_key(const std::string& source_digest, const Intrinsics& k,
                           const Distortion& d, const Intrinsics& pinhole) {
