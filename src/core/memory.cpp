@@ -7,7 +7,6 @@
 #include <fstream>
 #include <optional>
 #include <string>
-#include <vector>
 
 #include "core/error.hpp"
 #ifdef IESRGS_WITH_CUDA
@@ -33,6 +32,12 @@ int64_t proc_kib_field(const fs::path& file, const std::string& key) {
     status.ignore(1 << 16, '\n');
   }
   return -1;
+}
+
+// The lesser of two amounts of memory, where -1 is one nobody states (no limit): -1 when neither
+// is stated.
+int64_t least_stated(int64_t a, int64_t b) {
+  return a < 0 ? b : b < 0 ? a : std::min(a, b);
 }
 
 // The first number in `file`, -1 when there is none ("max", an absent file).
@@ -86,8 +91,7 @@ int64_t cgroup_memory_left(const fs::path& root, const std::string& path,
     if (limit >= 0 && limit < kNoLimit) {
       const int64_t used =
           file_number(level / names.usage) - stat_field(level / "memory.stat", names.inactive_file);
-      const int64_t left = std::max<int64_t>(0, limit - std::max<int64_t>(0, used));
-      least = least < 0 ? left : std::min(least, left);
+      least = least_stated(least, std::max<int64_t>(0, limit - std::max<int64_t>(0, used)));
     }
     if (level == root || !level.has_relative_path() || level == level.parent_path()) break;
   }
@@ -124,32 +128,28 @@ void restart_peak_memory() {
 }
 
 int64_t limited_memory_bytes(const fs::path& cgroup_mount, const fs::path& proc_self) {
-  std::vector<int64_t> left;
+  int64_t least = -1;
   if (const auto path = cgroup_path(proc_self, true))
-    left.push_back(
+    least = least_stated(
+        least,
         cgroup_memory_left(cgroup_mount, *path, {"memory.max", "memory.current", "inactive_file"}));
   if (const auto path = cgroup_path(proc_self, false))
-    left.push_back(cgroup_memory_left(
-        cgroup_mount / "memory", *path,
-        {"memory.limit_in_bytes", "memory.usage_in_bytes", "total_inactive_file"}));
+    least = least_stated(
+        least, cgroup_memory_left(
+                   cgroup_mount / "memory", *path,
+                   {"memory.limit_in_bytes", "memory.usage_in_bytes", "total_inactive_file"}));
   rlimit address_space{};
   if (::getrlimit(RLIMIT_AS, &address_space) == 0 && address_space.rlim_cur != RLIM_INFINITY) {
     const int64_t mapped = proc_kib_field(proc_self / "status", "VmSize:");
-    if (mapped >= 0) left.push_back(std::max<int64_t>(0, int64_t(address_space.rlim_cur) - mapped));
+    if (mapped >= 0)
+      least = least_stated(least, std::max<int64_t>(0, int64_t(address_space.rlim_cur) - mapped));
   }
-  int64_t least = -1;
-  for (const int64_t bytes : left)
-    if (bytes >= 0) least = least < 0 ? bytes : std::min(least, bytes);
   return least;
 }
 
 int64_t available_memory_bytes(torch::Device device) {
-  if (device.is_cpu()) {
-    const int64_t machine = proc_kib_field("/proc/meminfo", "MemAvailable:");
-    const int64_t limited = limited_memory_bytes();
-    if (machine < 0 || limited < 0) return std::max(machine, limited);
-    return std::min(machine, limited);
-  }
+  if (device.is_cpu())
+    return least_stated(proc_kib_field("/proc/meminfo", "MemAvailable:"), limited_memory_bytes());
 #ifdef IESRGS_WITH_CUDA
   if (device.is_cuda()) return cuda::free_memory_bytes();
 #endif
