@@ -233,10 +233,11 @@ std::vector<Vec3> looked_at_points(const Scene& scene, std::string& what) {
     what = "the scene's points";
     const size_t step = (points.size() + kMostPoints - 1) / kMostPoints;
     for (size_t i = 0; i < points.size(); i += step) targets.push_back(points[i]);
-  } else if (const std::optional<Vec3> focus = focus_point(scene.split(Split::Train))) {
+  } else if (const auto cameras = scene.split(Split::Train);
+             const auto focus = focus_point(cameras)) {
     const SceneNormalization sphere = scene.normalization();
     if ((*focus - sphere.center).norm() <= kConvergingSpreads * sphere.radius / 1.1 ||
-        axis_spread(scene.split(Split::Train)) > kConvergingAngle) {
+        axis_spread(cameras) > kConvergingAngle) {
       what = "the point their optical axes meet";
       targets.push_back(*focus);
     }

@@ -382,12 +382,11 @@ void Trainer::fail_out_of_memory() const {
 }
 
 void Trainer::fail_diverged(int64_t iteration, double loss) const {
-  const std::string kept = checkpoint_kept();
   fail(
       "training diverged at iteration {}: the {} stopped being finite (loss {}); {}. Lower the "
       "learning rates (or a run's depth loss weights, --li and --le), or check the input "
       "images and the starting model (--init-ply, random_extent).",
-      iteration, std::isfinite(loss) ? "parameters" : "loss", loss, kept);
+      iteration, std::isfinite(loss) ? "parameters" : "loss", loss, checkpoint_kept());
 }
 
 double Trainer::training_seconds() const {
